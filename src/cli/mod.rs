@@ -1,0 +1,94 @@
+//! Argument parsing and one file per subcommand; no algorithms here.
+//!
+//! Exit codes: 0 success, 1 some inputs failed (each reported), 2 usage
+//! error (unknown flag, impossible option value).
+
+mod inspect;
+mod retarget;
+mod synth;
+
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::process::ExitCode;
+
+/// Learn dynamical motion primitives from motion capture and follow a
+/// person through one camera.
+#[derive(Debug, Parser)]
+#[command(name = "imitate", version, about, propagate_version = true)]
+struct Cli {
+    #[command(flatten)]
+    global: Global,
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Flags every subcommand takes.
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct Global {
+    /// Print nothing but errors: no progress bars, summaries or warnings.
+    #[arg(short, long, global = true)]
+    pub quiet: bool,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    Inspect(inspect::Args),
+    Retarget(retarget::Args),
+    Synth(synth::Args),
+}
+
+/// How a command ended, when it did not fail outright.
+pub enum Outcome {
+    Success,
+    /// Some inputs failed; each has been reported.
+    SomeFailed,
+}
+
+/// A problem with the options themselves (exit code 2).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct UsageError(pub String);
+
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Inspect(args) => inspect::run(args, cli.global),
+        Command::Retarget(args) => retarget::run(args, cli.global),
+        Command::Synth(args) => synth::run(args, cli.global),
+    };
+    match result {
+        Ok(Outcome::Success) => ExitCode::SUCCESS,
+        Ok(Outcome::SomeFailed) => ExitCode::from(1),
+        Err(err) => {
+            eprintln!("imitate: error: {err:#}");
+            if err.downcast_ref::<UsageError>().is_some() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::from(1)
+            }
+        }
+    }
+}
+
+/// A progress bar on stderr, hidden when stderr is not a terminal or with
+/// `--quiet`.
+pub fn progress(global: Global, len: u64, message: &str) -> ProgressBar {
+    if global.quiet || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(len).with_message(message.to_string());
+    bar.set_style(
+        ProgressStyle::with_template("{msg:>12} [{bar:30}] {pos}/{len} {elapsed_precise}")
+            .expect("the template is valid")
+            .progress_chars("=> "),
+    );
+    bar
+}
+
+/// Prints a note on stderr unless `--quiet`.
+pub fn note(global: Global, text: &str) {
+    if !global.quiet {
+        eprintln!("{text}");
+    }
+}

@@ -1,0 +1,11 @@
+//! Motion capture: BVH files, source skeletons, the canonical humanoid,
+//! retargeting, and the procedural demonstrator.
+
+pub mod body;
+pub mod bvh;
+pub mod fk;
+pub mod math;
+pub mod names;
+pub mod pose;
+pub mod retarget;
+pub mod synth;
