@@ -2,7 +2,7 @@
 //! canonical body.
 
 use super::retarget::{UpArg, options};
-use super::{Global, Outcome};
+use super::{Global, Outcome, write_stdout};
 use imitate::mocap::bvh::{Bvh, Channel, Warning, read_bvh};
 use imitate::mocap::retarget::{Analysis, RetargetOptions, Retargeter};
 use serde::Serialize;
@@ -22,6 +22,10 @@ pub struct Args {
     /// Print one JSON array (one object per file) instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Also time reading each file (MB/s, frames/s) and print the process's
+    /// peak resident memory beside the size of the decoded values.
+    #[arg(long)]
+    pub timing: bool,
     /// The source's up axis, when detection from the skeleton gets it wrong.
     #[arg(long, value_enum)]
     pub up: Option<UpArg>,
@@ -44,6 +48,8 @@ struct Report {
 
 #[derive(Debug, Serialize)]
 struct Contents {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    timing: Option<Timing>,
     joints: usize,
     roots: Vec<String>,
     frames: usize,
@@ -66,46 +72,72 @@ struct Contents {
     standing_height_m: Option<f64>,
 }
 
+/// How long reading took (`--timing`).
+#[derive(Debug, Serialize)]
+struct Timing {
+    read_s: f64,
+    file_mb: f64,
+    mb_per_s: f64,
+    frames_per_s: f64,
+    /// Size of the decoded channel values (8 bytes each), MB.
+    decoded_mb: f64,
+}
+
 pub fn run(args: Args, _global: Global) -> anyhow::Result<Outcome> {
     let options = options(args.up, args.mapping.as_deref())?;
-    let reports: Vec<Report> = args.files.iter().map(|f| inspect(f, &options)).collect();
+    let reports: Vec<Report> = args.files.iter().map(|f| inspect(f, &options, args.timing)).collect();
+    let mut text = String::new();
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&reports)?);
+        text = serde_json::to_string_pretty(&reports)? + "\n";
     } else {
         for (i, report) in reports.iter().enumerate() {
             if i > 0 {
-                println!();
+                text.push('\n');
             }
-            print_text(report);
+            write_text(report, &mut text);
         }
     }
+    write_stdout(&text)?;
     for report in reports.iter().filter(|r| !r.ok) {
-        eprintln!(
-            "imitate: error: {}",
-            report.error.as_deref().unwrap_or("failed")
-        );
+        eprintln!("imitate: error: {}", report.error.as_deref().unwrap_or("failed"));
     }
-    Ok(if reports.iter().all(|r| r.ok) {
-        Outcome::Success
-    } else {
-        Outcome::SomeFailed
-    })
+    if args.timing {
+        let decoded = reports
+            .iter()
+            .filter_map(|r| r.contents.as_ref()?.timing.as_ref().map(|t| t.decoded_mb))
+            .fold(0.0, f64::max);
+        match peak_resident_mb() {
+            Some(peak) => eprintln!(
+                "peak resident memory {peak:.1} MB; largest decoded take {decoded:.1} MB ({:.2}×)",
+                peak / decoded.max(f64::MIN_POSITIVE)
+            ),
+            None => eprintln!("peak resident memory: not available on this system"),
+        }
+    }
+    Ok(if reports.iter().all(|r| r.ok) { Outcome::Success } else { Outcome::SomeFailed })
 }
 
-fn inspect(path: &Path, options: &RetargetOptions) -> Report {
+fn inspect(path: &Path, options: &RetargetOptions, timed: bool) -> Report {
     let file = path.display().to_string();
+    let start = std::time::Instant::now();
     let bvh = match read_bvh(path) {
         Ok(b) => b,
         Err(e) => {
-            return Report {
-                file,
-                ok: false,
-                error: Some(e.to_string()),
-                contents: None,
-            };
+            return Report { file, ok: false, error: Some(e.to_string()), contents: None };
         }
     };
+    let read_s = start.elapsed().as_secs_f64();
     let mut contents = describe(&bvh);
+    if timed {
+        let file_mb = std::fs::metadata(path).map(|m| m.len() as f64 / 1e6).unwrap_or(0.0);
+        contents.timing = Some(Timing {
+            read_s,
+            file_mb,
+            mb_per_s: file_mb / read_s,
+            frames_per_s: bvh.frames as f64 / read_s,
+            decoded_mb: (bvh.data.len() * std::mem::size_of::<f64>()) as f64 / 1e6,
+        });
+    }
     let (analysis, error) = match Retargeter::new(&bvh, options) {
         Ok(r) => (Some(r.analysis().clone()), None),
         Err(e) => (None, Some(format!("{file}: {e}"))),
@@ -115,12 +147,7 @@ fn inspect(path: &Path, options: &RetargetOptions) -> Report {
         contents.standing_height_m = Some(a.height_units * a.meters_per_unit);
     }
     contents.analysis = analysis;
-    Report {
-        file,
-        ok: error.is_none(),
-        error,
-        contents: Some(contents),
-    }
+    Report { file, ok: error.is_none(), error, contents: Some(contents) }
 }
 
 fn describe(bvh: &Bvh) -> Contents {
@@ -140,22 +167,16 @@ fn describe(bvh: &Bvh) -> Contents {
         }
     }
     Contents {
+        timing: None,
         joints: skeleton.joints.len(),
-        roots: skeleton
-            .roots()
-            .map(|r| skeleton.joints[r].name.clone())
-            .collect(),
+        roots: skeleton.roots().map(|r| skeleton.joints[r].name.clone()).collect(),
         frames: bvh.frames,
         declared_frames: bvh.declared_frames,
         frame_time_s: bvh.frame_time_s,
         frame_rate_hz: bvh.frame_rate_hz(),
         duration_s: bvh.duration_s(),
         channels: bvh.channel_count(),
-        root_channels: skeleton.joints[0]
-            .channels
-            .iter()
-            .map(|c| c.name())
-            .collect(),
+        root_channels: skeleton.joints[0].channels.iter().map(|c| c.name()).collect(),
         rotation_orders,
         warnings: bvh.warnings.clone(),
         analysis: None,
@@ -163,128 +184,88 @@ fn describe(bvh: &Bvh) -> Contents {
     }
 }
 
-fn print_text(report: &Report) {
-    println!("{}", report.file);
+/// The process's peak resident set size (Linux `VmHWM`), MB.
+fn peak_resident_mb() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024.0 / 1e6)
+}
+
+/// The text form of one report.
+fn write_text(report: &Report, out: &mut String) {
+    out.push_str(&format!("{}\n", report.file));
     let Some(c) = &report.contents else {
-        println!(
-            "  error       {}",
-            report.error.as_deref().unwrap_or_default()
-        );
+        field(out, "error", report.error.clone().unwrap_or_default());
         return;
     };
-    let field = |name: &str, value: String| println!("  {name:<12}{value}");
-    field(
-        "joints",
-        format!(
-            "{} (root{}: {})",
-            c.joints,
-            if c.roots.len() > 1 { "s" } else { "" },
-            c.roots.join(", ")
-        ),
+    let roots = format!("{} (root{}: {})", c.joints, if c.roots.len() > 1 { "s" } else { "" }, c.roots.join(", "));
+    field(out, "joints", roots);
+    let declared =
+        if c.declared_frames != c.frames as u64 { format!("; {} declared", c.declared_frames) } else { String::new() };
+    let frames = format!(
+        "{} at {:.3} Hz ({:.6} s per frame), {:.3} s{declared}",
+        c.frames, c.frame_rate_hz, c.frame_time_s, c.duration_s
     );
-    field(
-        "frames",
-        format!(
-            "{} at {:.3} Hz ({:.6} s per frame), {:.3} s{}",
-            c.frames,
-            c.frame_rate_hz,
-            c.frame_time_s,
-            c.duration_s,
-            if c.declared_frames != c.frames as u64 {
-                format!("; {} declared", c.declared_frames)
-            } else {
-                String::new()
-            }
-        ),
-    );
-    let orders: Vec<String> = c
-        .rotation_orders
-        .iter()
-        .map(|(o, n)| format!("{o} ×{n}"))
-        .collect();
-    field(
-        "channels",
-        format!(
-            "{}; rotation orders {}; root: {}",
-            c.channels,
-            orders.join(", "),
-            c.root_channels.join(" ")
-        ),
-    );
+    field(out, "frames", frames);
+    if let Some(t) = &c.timing {
+        let read = format!(
+            "{:.3} s for {:.1} MB: {:.0} MB/s, {:.0} frames/s; {:.1} MB of decoded values",
+            t.read_s, t.file_mb, t.mb_per_s, t.frames_per_s, t.decoded_mb
+        );
+        field(out, "read", read);
+    }
+    let orders: Vec<String> = c.rotation_orders.iter().map(|(o, n)| format!("{o} ×{n}")).collect();
+    let channels =
+        format!("{}; rotation orders {}; root: {}", c.channels, orders.join(", "), c.root_channels.join(" "));
+    field(out, "channels", channels);
     match &c.analysis {
         Some(a) => {
             let height = c.standing_height_m.unwrap_or_default();
             let units = if a.units == "unknown" {
-                format!(
-                    "unknown; scaled as a {height:.2} m body ({:.4} m per unit)",
-                    a.meters_per_unit
-                )
+                format!("unknown; scaled as a {height:.2} m body ({:.4} m per unit)", a.meters_per_unit)
             } else {
-                format!(
-                    "{} ({} m per unit); stands {height:.2} m tall",
-                    a.units, a.meters_per_unit
-                )
+                format!("{} ({} m per unit); stands {height:.2} m tall", a.units, a.meters_per_unit)
             };
-            field("units", units);
-            field(
-                "up axis",
-                format!(
-                    "{} ({})",
-                    a.up_axis,
-                    if a.up_detected {
-                        "detected"
-                    } else {
-                        "from --up"
-                    }
-                ),
-            );
-            field("naming", a.scheme.to_string());
-            let pairs: Vec<String> = a
-                .mapping
-                .iter()
-                .filter_map(|m| m.source.as_ref().map(|s| format!("{} ← {s}", m.canonical)))
-                .collect();
-            print_wrapped("mapping", &pairs);
+            field(out, "units", units);
+            field(out, "up axis", format!("{} ({})", a.up_axis, if a.up_detected { "detected" } else { "from --up" }));
+            field(out, "naming", a.scheme.to_string());
+            let pairs: Vec<String> =
+                a.mapping.iter().filter_map(|m| m.source.as_ref().map(|s| format!("{} ← {s}", m.canonical))).collect();
+            wrapped(out, "mapping", &pairs);
             let missing = if a.missing.is_empty() {
                 vec!["none".to_string()]
             } else {
                 a.missing.iter().map(|m| m.to_string()).collect()
             };
-            print_wrapped("missing", &missing);
-            let modes: Vec<String> = a
-                .position_channels
-                .iter()
-                .map(|(j, m)| format!("{j}: {m:?}"))
-                .collect();
+            wrapped(out, "missing", &missing);
+            let modes: Vec<String> = a.position_channels.iter().map(|(j, m)| format!("{j}: {m:?}")).collect();
             if !modes.is_empty() {
-                print_wrapped("positions", &modes);
+                wrapped(out, "positions", &modes);
             }
         }
-        None => field(
-            "mapping",
-            report
-                .error
-                .clone()
-                .unwrap_or_default()
-                .replace('\n', "\n              "),
-        ),
+        None => field(out, "mapping", report.error.clone().unwrap_or_default().replace('\n', "\n              ")),
     }
     if c.warnings.is_empty() {
-        field("warnings", "none".into());
+        field(out, "warnings", "none".into());
     }
     for w in &c.warnings {
-        field("warning", w.message.clone());
+        field(out, "warning", w.message.clone());
     }
 }
 
-/// Prints `items` comma-separated after a field name, wrapped to fit 100
-/// columns.
-fn print_wrapped(name: &str, items: &[String]) {
+/// One `name  value` line of a text report.
+fn field(out: &mut String, name: &str, value: String) {
+    out.push_str(&format!("  {name:<12}{value}\n"));
+}
+
+/// `items` comma-separated after a field name, wrapped to fit 100 columns.
+fn wrapped(out: &mut String, name: &str, items: &[String]) {
     let mut line = String::new();
     let mut first = true;
     for item in items {
         if !line.is_empty() && line.len() + item.len() > 84 {
-            println!("  {:<12}{line},", if first { name } else { "" });
+            field(out, if first { name } else { "" }, format!("{line},"));
             line.clear();
             first = false;
         }
@@ -293,5 +274,5 @@ fn print_wrapped(name: &str, items: &[String]) {
         }
         line.push_str(item);
     }
-    println!("  {:<12}{line}", if first { name } else { "" });
+    field(out, if first { name } else { "" }, line);
 }

@@ -62,11 +62,7 @@ pub fn main() -> ExitCode {
         Ok(Outcome::SomeFailed) => ExitCode::from(1),
         Err(err) => {
             eprintln!("imitate: error: {err:#}");
-            if err.downcast_ref::<UsageError>().is_some() {
-                ExitCode::from(2)
-            } else {
-                ExitCode::from(1)
-            }
+            if err.downcast_ref::<UsageError>().is_some() { ExitCode::from(2) } else { ExitCode::from(1) }
         }
     }
 }
@@ -84,6 +80,17 @@ pub fn progress(global: Global, len: u64, message: &str) -> ProgressBar {
             .progress_chars("=> "),
     );
     bar
+}
+
+/// Writes a command's output to stdout. A reader that closed the pipe
+/// early (`imitate inspect … | head`) has all it wanted: not an error.
+pub fn write_stdout(text: &str) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut stdout = std::io::stdout().lock();
+    match stdout.write_all(text.as_bytes()).and_then(|()| stdout.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => other,
+    }
 }
 
 /// Prints a note on stderr unless `--quiet`.

@@ -46,10 +46,7 @@ impl From<UpArg> for UpAxis {
 /// Reads the options shared with `inspect`.
 pub fn options(up: Option<UpArg>, mapping: Option<&Path>) -> anyhow::Result<RetargetOptions> {
     let mapping = mapping.map(UserMapping::load).transpose()?;
-    Ok(RetargetOptions {
-        up: up.map(Into::into),
-        mapping,
-    })
+    Ok(RetargetOptions { up: up.map(Into::into), mapping })
 }
 
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {

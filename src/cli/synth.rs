@@ -70,14 +70,8 @@ fn activity(name: &str) -> Result<Activity, String> {
 /// A parser for a number in `[lo, hi]`.
 fn within(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone {
     move |text: &str| {
-        let v: f64 = text
-            .parse()
-            .map_err(|_| format!("`{text}` is not a number"))?;
-        if (lo..=hi).contains(&v) {
-            Ok(v)
-        } else {
-            Err(format!("{v} is outside {lo} to {hi}"))
-        }
+        let v: f64 = text.parse().map_err(|_| format!("`{text}` is not a number"))?;
+        if (lo..=hi).contains(&v) { Ok(v) } else { Err(format!("{v} is outside {lo} to {hi}")) }
     }
 }
 
@@ -86,18 +80,13 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         speed: args.speed,
         repetitions: args.reps as usize,
         amplitude: args.amplitude,
-        proportions: Proportions {
-            height_m: args.height,
-            arm_scale: args.arm_scale,
-            leg_scale: args.leg_scale,
-        },
+        proportions: Proportions { height_m: args.height, arm_scale: args.arm_scale, leg_scale: args.leg_scale },
         noise_deg: args.noise,
         variation: args.variation,
         fps: args.fps,
         seed: args.seed,
     };
-    std::fs::create_dir_all(&args.output)
-        .with_context(|| format!("cannot create {}", args.output.display()))?;
+    std::fs::create_dir_all(&args.output).with_context(|| format!("cannot create {}", args.output.display()))?;
     let labels_path = args.output.join("labels.csv");
     if !args.sequence.is_empty() {
         let take = sequence_take(&args.sequence, &options);
@@ -111,23 +100,11 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             Ok(())
         })
         .with_context(|| format!("cannot write {}", labels_path.display()))?;
-        note(
-            global,
-            &format!(
-                "wrote {} ({}) and {}",
-                path.display(),
-                describe(&take),
-                labels_path.display()
-            ),
-        );
+        note(global, &format!("wrote {} ({}) and {}", path.display(), describe(&take), labels_path.display()));
         return Ok(Outcome::Success);
     }
 
-    let activities = if args.activities.is_empty() {
-        Activity::ALL.to_vec()
-    } else {
-        args.activities
-    };
+    let activities = if args.activities.is_empty() { Activity::ALL.to_vec() } else { args.activities };
     let bar = progress(global, activities.len() as u64, "synth");
     let mut rows = Vec::new();
     for activity in activities {
@@ -147,10 +124,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     })
     .with_context(|| format!("cannot write {}", labels_path.display()))?;
     for (file, _, summary) in &rows {
-        note(
-            global,
-            &format!("wrote {} ({summary})", args.output.join(file).display()),
-        );
+        note(global, &format!("wrote {} ({summary})", args.output.join(file).display()));
     }
     note(global, &format!("wrote {}", labels_path.display()));
     Ok(Outcome::Success)
@@ -158,14 +132,10 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
 
 fn write_take(path: &Path, take: &Take) -> anyhow::Result<()> {
     let bvh = take.motion.to_bvh();
-    write_atomic(path, |w| write_bvh(&bvh, w))
-        .with_context(|| format!("cannot write {}", path.display()))
+    write_atomic(path, |w| write_bvh(&bvh, w)).with_context(|| format!("cannot write {}", path.display()))
 }
 
 fn describe(take: &Take) -> String {
     let frames = take.motion.poses.len();
-    format!(
-        "{frames} frames, {:.1} s",
-        frames as f64 * take.motion.frame_time_s
-    )
+    format!("{frames} frames, {:.1} s", frames as f64 * take.motion.frame_time_s)
 }

@@ -48,11 +48,7 @@ pub enum Kind {
     /// Three rotational degrees of freedom, stored as an exponential map.
     Ball { max_angle_rad: f64 },
     /// One angle about a fixed axis of the parent's frame.
-    Hinge {
-        axis: DVec3,
-        min_rad: f64,
-        max_rad: f64,
-    },
+    Hinge { axis: DVec3, min_rad: f64, max_rad: f64 },
 }
 
 impl Joint {
@@ -150,14 +146,8 @@ impl Joint {
     pub fn kind(self) -> Kind {
         use Joint::*;
         let deg = f64::to_radians;
-        let ball = |max: f64| Kind::Ball {
-            max_angle_rad: deg(max),
-        };
-        let hinge = |axis, min: f64, max: f64| Kind::Hinge {
-            axis,
-            min_rad: deg(min),
-            max_rad: deg(max),
-        };
+        let ball = |max: f64| Kind::Ball { max_angle_rad: deg(max) };
+        let hinge = |axis, min: f64, max: f64| Kind::Hinge { axis, min_rad: deg(min), max_rad: deg(max) };
         match self {
             // Flexion is positive: the forearm swings forward (+Z) from the
             // T-pose, the shin backward.
@@ -195,9 +185,7 @@ impl Joint {
         use Joint::*;
         match self {
             Pelvis => EulerOrder::YXZ,
-            LeftShoulder | LeftElbow | LeftWrist | RightShoulder | RightElbow | RightWrist => {
-                EulerOrder::ZXY
-            }
+            LeftShoulder | LeftElbow | LeftWrist | RightShoulder | RightElbow | RightWrist => EulerOrder::ZXY,
             LeftAnkle | RightAnkle => EulerOrder([Axis::X, Axis::Z, Axis::Y]),
             _ => EulerOrder::ZYX,
         }
@@ -236,11 +224,7 @@ pub struct Proportions {
 
 impl Default for Proportions {
     fn default() -> Self {
-        Proportions {
-            height_m: Body::STANDARD_HEIGHT_M,
-            arm_scale: 1.0,
-            leg_scale: 1.0,
-        }
+        Proportions { height_m: Body::STANDARD_HEIGHT_M, arm_scale: 1.0, leg_scale: 1.0 }
     }
 }
 
@@ -284,24 +268,8 @@ impl Body {
         set(Neck, 0.0, 0.097 * h, 0.0);
         set(Head, 0.0, 0.057 * h, 0.0);
         for (side, shoulder, elbow, wrist, hip, knee, ankle) in [
-            (
-                1.0,
-                LeftShoulder,
-                LeftElbow,
-                LeftWrist,
-                LeftHip,
-                LeftKnee,
-                LeftAnkle,
-            ),
-            (
-                -1.0,
-                RightShoulder,
-                RightElbow,
-                RightWrist,
-                RightHip,
-                RightKnee,
-                RightAnkle,
-            ),
+            (1.0, LeftShoulder, LeftElbow, LeftWrist, LeftHip, LeftKnee, LeftAnkle),
+            (-1.0, RightShoulder, RightElbow, RightWrist, RightHip, RightKnee, RightAnkle),
         ] {
             set(shoulder, side * 0.109 * h, 0.086 * h, 0.0);
             set(elbow, side * 0.186 * h * arm, 0.0, 0.0);
@@ -318,11 +286,7 @@ impl Body {
         for ankle in [LeftAnkle, RightAnkle] {
             ends[ankle.index()] = Some(DVec3::new(0.0, -0.030 * h, 0.110 * h));
         }
-        Body {
-            proportions: p,
-            offsets,
-            ends,
-        }
+        Body { proportions: p, offsets, ends }
     }
 
     /// Rest offset of `j` from its parent (for the pelvis: its rest
@@ -356,10 +320,7 @@ impl Body {
 
     /// Length of the path pelvis → spine → chest → neck → head → head top.
     pub fn trunk_length(&self) -> f64 {
-        [Joint::Spine, Joint::Chest, Joint::Neck, Joint::Head]
-            .iter()
-            .map(|&j| self.offset(j).length())
-            .sum::<f64>()
+        [Joint::Spine, Joint::Chest, Joint::Neck, Joint::Head].iter().map(|&j| self.offset(j).length()).sum::<f64>()
             + self.bone(Joint::Head).length()
     }
 }
@@ -389,12 +350,10 @@ mod tests {
     #[test]
     fn standard_body_stands_on_the_ground_at_its_height() {
         let body = Body::standard();
-        let head_top = [Joint::Spine, Joint::Chest, Joint::Neck, Joint::Head]
-            .iter()
-            .map(|&j| body.offset(j).y)
-            .sum::<f64>()
-            + body.pelvis_height()
-            + body.end_site(Joint::Head).unwrap().y;
+        let head_top =
+            [Joint::Spine, Joint::Chest, Joint::Neck, Joint::Head].iter().map(|&j| body.offset(j).y).sum::<f64>()
+                + body.pelvis_height()
+                + body.end_site(Joint::Head).unwrap().y;
         assert!((head_top - 1.75).abs() < 0.01, "head top at {head_top}");
         let ankle = body.pelvis_height() + body.offset(Joint::LeftHip).y - body.leg_length();
         assert!((ankle - 0.039 * 1.75).abs() < 1e-12);
@@ -402,15 +361,8 @@ mod tests {
 
     #[test]
     fn proportions_scale_limbs_and_keep_feet_on_the_ground() {
-        let tall_legs = Body::new(Proportions {
-            height_m: 1.6,
-            arm_scale: 1.1,
-            leg_scale: 1.2,
-        });
-        let base = Body::new(Proportions {
-            height_m: 1.6,
-            ..Default::default()
-        });
+        let tall_legs = Body::new(Proportions { height_m: 1.6, arm_scale: 1.1, leg_scale: 1.2 });
+        let base = Body::new(Proportions { height_m: 1.6, ..Default::default() });
         assert!((tall_legs.leg_length() - 1.2 * base.leg_length()).abs() < 1e-12);
         let arm = |b: &Body| b.offset(Joint::LeftElbow).length();
         assert!((arm(&tall_legs) - 1.1 * arm(&base)).abs() < 1e-12);

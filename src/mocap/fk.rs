@@ -47,10 +47,7 @@ pub struct Transform {
 
 impl Default for Transform {
     fn default() -> Self {
-        Transform {
-            position: DVec3::ZERO,
-            rotation: DQuat::IDENTITY,
-        }
+        Transform { position: DVec3::ZERO, rotation: DQuat::IDENTITY }
     }
 }
 
@@ -74,13 +71,7 @@ impl Kinematics {
                     }
                 }
                 let mode = detect_mode(bvh, &samples, joint.offset, &positions);
-                JointPlan {
-                    parent: joint.parent,
-                    offset: joint.offset,
-                    rotations,
-                    positions,
-                    mode,
-                }
+                JointPlan { parent: joint.parent, offset: joint.offset, rotations, positions, mode }
             })
             .collect();
         Kinematics { joints }
@@ -88,11 +79,7 @@ impl Kinematics {
 
     /// The position convention of joint `j`, when it has position channels.
     pub fn position_mode(&self, j: usize) -> Option<PositionMode> {
-        self.joints[j]
-            .positions
-            .iter()
-            .any(Option::is_some)
-            .then_some(self.joints[j].mode)
+        self.joints[j].positions.iter().any(Option::is_some).then_some(self.joints[j].mode)
     }
 
     /// Local translation and rotation of joint `j` in `frame`.
@@ -124,16 +111,10 @@ impl Kinematics {
             }
             let (t, r) = self.local(j, frame);
             out[j] = match plan.parent {
-                None => Transform {
-                    position: t,
-                    rotation: r,
-                },
+                None => Transform { position: t, rotation: r },
                 Some(p) => {
                     let parent = out[p];
-                    Transform {
-                        position: parent.position + parent.rotation * t,
-                        rotation: parent.rotation * r,
-                    }
+                    Transform { position: parent.position + parent.rotation * t, rotation: parent.rotation * r }
                 }
             };
         }
@@ -159,25 +140,12 @@ impl Kinematics {
 /// Up to [`SAMPLE_FRAMES`] frame indices spread evenly over the take.
 pub fn sample_frames(frames: usize) -> Vec<usize> {
     let n = frames.min(SAMPLE_FRAMES);
-    (0..n)
-        .map(|i| {
-            if n == 1 {
-                0
-            } else {
-                i * (frames - 1) / (n - 1)
-            }
-        })
-        .collect()
+    (0..n).map(|i| if n == 1 { 0 } else { i * (frames - 1) / (n - 1) }).collect()
 }
 
 /// Absolute when the channels' typical values sit nearer the OFFSET than
 /// zero: deltas hover around zero, absolute positions around the offset.
-fn detect_mode(
-    bvh: &Bvh,
-    samples: &[usize],
-    offset: DVec3,
-    positions: &[Option<usize>; 3],
-) -> PositionMode {
+fn detect_mode(bvh: &Bvh, samples: &[usize], offset: DVec3, positions: &[Option<usize>; 3]) -> PositionMode {
     if offset.length() < 1e-9 || positions.iter().all(Option::is_none) || samples.is_empty() {
         return PositionMode::Delta;
     }
@@ -219,36 +187,24 @@ mod tests {
 
     #[test]
     fn absolute_position_channels_equal_to_the_offset_do_not_double_the_bone() {
-        let bvh = two_bone(
-            "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation",
-            "0 0 0 0 10 0 0 0 0",
-        );
-        assert_eq!(
-            Kinematics::new(&bvh).position_mode(1),
-            Some(PositionMode::Absolute)
-        );
+        let bvh =
+            two_bone("CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation", "0 0 0 0 10 0 0 0 0");
+        assert_eq!(Kinematics::new(&bvh).position_mode(1), Some(PositionMode::Absolute));
         assert!((joint_b_height(&bvh) - 10.0).abs() < 1e-12);
     }
 
     #[test]
     fn delta_position_channels_add_to_the_offset() {
-        let bvh = two_bone(
-            "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation",
-            "0 0 0 0 0.5 0 0 0 0",
-        );
-        assert_eq!(
-            Kinematics::new(&bvh).position_mode(1),
-            Some(PositionMode::Delta)
-        );
+        let bvh =
+            two_bone("CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation", "0 0 0 0 0.5 0 0 0 0");
+        assert_eq!(Kinematics::new(&bvh).position_mode(1), Some(PositionMode::Delta));
         assert!((joint_b_height(&bvh) - 10.5).abs() < 1e-12);
     }
 
     #[test]
     fn position_channels_listed_after_rotations_still_translate_before_rotating() {
-        let bvh = two_bone(
-            "CHANNELS 6 Zrotation Xrotation Yrotation Xposition Yposition Zposition",
-            "0 0 0 90 0 0 0 10 0",
-        );
+        let bvh =
+            two_bone("CHANNELS 6 Zrotation Xrotation Yrotation Xposition Yposition Zposition", "0 0 0 90 0 0 0 10 0");
         // The rotation turns b's own frame; b itself stays at its offset.
         assert!((joint_b_height(&bvh) - 10.0).abs() < 1e-12);
     }
@@ -269,9 +225,6 @@ mod tests {
         assert_eq!(sample_frames(0), Vec::<usize>::new());
         assert_eq!(sample_frames(1), vec![0]);
         let s = sample_frames(10_000);
-        assert_eq!(
-            (s.len(), s[0], *s.last().unwrap()),
-            (SAMPLE_FRAMES, 0, 9_999)
-        );
+        assert_eq!((s.len(), s[0], *s.last().unwrap()), (SAMPLE_FRAMES, 0, 9_999));
     }
 }

@@ -73,9 +73,7 @@ impl EulerOrder {
 
     /// The quaternion for angles (radians) given in this order.
     pub fn to_quat(self, angles: [f64; 3]) -> DQuat {
-        self.0[0].rotation(angles[0])
-            * self.0[1].rotation(angles[1])
-            * self.0[2].rotation(angles[2])
+        self.0[0].rotation(angles[0]) * self.0[1].rotation(angles[1]) * self.0[2].rotation(angles[2])
     }
 
     /// Angles (radians) in this order that reproduce `q`. Stable at gimbal
@@ -197,9 +195,7 @@ mod tests {
     #[test]
     fn euler_order_matches_product_of_axis_rotations_left_to_right() {
         let q = EulerOrder::ZXY.to_quat([0.3, -0.7, 1.1]);
-        let m = DQuat::from_rotation_z(0.3)
-            * DQuat::from_rotation_x(-0.7)
-            * DQuat::from_rotation_y(1.1);
+        let m = DQuat::from_rotation_z(0.3) * DQuat::from_rotation_x(-0.7) * DQuat::from_rotation_y(1.1);
         assert!(angle_between(q, m) < 1e-14);
     }
 
@@ -208,11 +204,7 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
         for order in ORDERS {
             for n in 0..2000 {
-                let mut angles = [
-                    rng.gen_range(-3.1..3.1),
-                    rng.gen_range(-1.5..1.5),
-                    rng.gen_range(-3.1..3.1),
-                ];
+                let mut angles = [rng.gen_range(-3.1..3.1), rng.gen_range(-1.5..1.5), rng.gen_range(-3.1..3.1)];
                 // Every fourth sample sits on or within 1e-12 of the lock.
                 if n % 4 == 0 {
                     let near = std::f64::consts::FRAC_PI_2 - rng.gen_range(0.0..1e-12);
@@ -220,11 +212,7 @@ mod tests {
                 }
                 let q = order.to_quat(angles);
                 let back = order.to_quat(order.from_quat(q));
-                assert!(
-                    angle_between(q, back) < 1e-12,
-                    "{} {angles:?}",
-                    order.name()
-                );
+                assert!(angle_between(q, back) < 1e-12, "{} {angles:?}", order.name());
             }
         }
     }
@@ -233,19 +221,12 @@ mod tests {
     fn log_inverts_exp_from_tiny_angles_to_nearly_pi() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
         for _ in 0..5000 {
-            let axis = DVec3::new(
-                rng.r#gen::<f64>() - 0.5,
-                rng.r#gen::<f64>() - 0.5,
-                rng.r#gen::<f64>() - 0.5,
-            )
-            .normalize();
+            let axis =
+                DVec3::new(rng.r#gen::<f64>() - 0.5, rng.r#gen::<f64>() - 0.5, rng.r#gen::<f64>() - 0.5).normalize();
             let angle = 10f64.powf(rng.gen_range(-14.0..0.497)); // up to 3.14
             let v = axis * angle;
             let back = log_map(exp_map(v));
-            assert!(
-                (back - v).length() <= 1e-14 + 1e-12 * angle,
-                "{v:?} -> {back:?}"
-            );
+            assert!((back - v).length() <= 1e-14 + 1e-12 * angle, "{v:?} -> {back:?}");
         }
     }
 
@@ -259,13 +240,8 @@ mod tests {
 
     #[test]
     fn frame_from_directions_matches_primary_exactly_and_secondary_in_plane() {
-        let q = frame_from_directions(
-            DVec3::X,
-            DVec3::Z,
-            DVec3::new(0.0, -1.0, 0.2),
-            DVec3::new(1.0, 0.3, 0.0),
-        )
-        .unwrap();
+        let q =
+            frame_from_directions(DVec3::X, DVec3::Z, DVec3::new(0.0, -1.0, 0.2), DVec3::new(1.0, 0.3, 0.0)).unwrap();
         let p = q * DVec3::X;
         assert!((p - DVec3::new(0.0, -1.0, 0.2).normalize()).length() < 1e-14);
         let s = q * DVec3::Z;

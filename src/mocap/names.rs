@@ -42,20 +42,14 @@ impl Landmark {
             Landmark::Joint(j) => j.index(),
             extra => {
                 crate::mocap::body::JOINTS
-                    + Landmark::EXTRAS
-                        .iter()
-                        .position(|&e| e == extra)
-                        .expect("extras are listed")
+                    + Landmark::EXTRAS.iter().position(|&e| e == extra).expect("extras are listed")
             }
         }
     }
 
     /// Every landmark: the canonical joints, then the extras.
     pub fn all() -> impl Iterator<Item = Landmark> {
-        Joint::ALL
-            .into_iter()
-            .map(Landmark::Joint)
-            .chain(Landmark::EXTRAS)
+        Joint::ALL.into_iter().map(Landmark::Joint).chain(Landmark::EXTRAS)
     }
 
     pub fn name(self) -> &'static str {
@@ -113,11 +107,7 @@ impl SourcePoint {
     /// How the point reads in reports and mapping files.
     pub fn describe(self, skeleton: &Skeleton) -> String {
         let name = &skeleton.joints[self.joint].name;
-        if self.end_site {
-            format!("{name} (End Site)")
-        } else {
-            name.clone()
-        }
+        if self.end_site { format!("{name} (End Site)") } else { name.clone() }
     }
 }
 
@@ -206,10 +196,7 @@ const SCHEMES: &[Scheme] = &[
             ("*_shoulder", &["*Arm"]),
             ("*_elbow", &["*ForeArm"]),
             ("*_wrist", &["*Hand"]),
-            (
-                "*_hand_tip",
-                &["*HandMiddle1", "*HandIndex1", "*InHandMiddle"],
-            ),
+            ("*_hand_tip", &["*HandMiddle1", "*HandIndex1", "*InHandMiddle"]),
             ("*_thumb", &["*HandThumb1"]),
             ("*_hip", &["*UpLeg"]),
             ("*_knee", &["*Leg"]),
@@ -293,16 +280,11 @@ impl Mapping {
 
     /// Landmarks without a source point.
     pub fn missing(&self) -> Vec<Landmark> {
-        Landmark::all()
-            .filter(|l| !self.points.contains_key(l))
-            .collect()
+        Landmark::all().filter(|l| !self.points.contains_key(l)).collect()
     }
 
     pub fn missing_required(&self) -> Vec<Landmark> {
-        self.missing()
-            .into_iter()
-            .filter(|l| l.is_required())
-            .collect()
+        self.missing().into_iter().filter(|l| l.is_required()).collect()
     }
 }
 
@@ -317,89 +299,53 @@ pub struct UserMapping {
 #[derive(Debug, thiserror::Error)]
 pub enum MappingError {
     #[error("{path}: cannot read: {source}")]
-    Io {
-        path: String,
-        source: std::io::Error,
-    },
+    Io { path: String, source: std::io::Error },
     #[error("{path}: not valid TOML: {message}")]
     Toml { path: String, message: String },
     #[error("{path}: `{key}` is not a canonical joint or landmark; use one of: {valid}")]
-    UnknownLandmark {
-        path: String,
-        key: String,
-        valid: String,
-    },
+    UnknownLandmark { path: String, key: String, valid: String },
     #[error("{path}: `{key}` must be a joint name in quotes or {{ end_of = \"JOINT\" }}")]
     BadValue { path: String, key: String },
-    #[error(
-        "{path}: `{key} = \"{joint}\"`, but the skeleton has no joint `{joint}`; its joints are: {available}"
-    )]
-    UnknownJoint {
-        path: String,
-        key: String,
-        joint: String,
-        available: String,
-    },
+    #[error("{path}: `{key} = \"{joint}\"`, but the skeleton has no joint `{joint}`; its joints are: {available}")]
+    UnknownJoint { path: String, key: String, joint: String, available: String },
     #[error("{path}: `{key}` names the End Site of `{joint}`, which has none")]
-    NoEndSite {
-        path: String,
-        key: String,
-        joint: String,
-    },
+    NoEndSite { path: String, key: String, joint: String },
 }
 
 impl UserMapping {
     pub fn load(path: &Path) -> Result<UserMapping, MappingError> {
         let display = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| MappingError::Io {
-            path: display.clone(),
-            source,
-        })?;
+        let text =
+            std::fs::read_to_string(path).map_err(|source| MappingError::Io { path: display.clone(), source })?;
         UserMapping::parse(&text, &display)
     }
 
     pub fn parse(text: &str, path: &str) -> Result<UserMapping, MappingError> {
         let table: toml::Table = text
             .parse()
-            .map_err(|e: toml::de::Error| MappingError::Toml {
-                path: path.into(),
-                message: e.to_string(),
-            })?;
+            .map_err(|e: toml::de::Error| MappingError::Toml { path: path.into(), message: e.to_string() })?;
         let mut entries = Vec::new();
         for (key, value) in table {
-            let landmark =
-                Landmark::from_name(&key).ok_or_else(|| MappingError::UnknownLandmark {
-                    path: path.into(),
-                    key: key.clone(),
-                    valid: Landmark::all()
-                        .map(Landmark::name)
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                })?;
+            let landmark = Landmark::from_name(&key).ok_or_else(|| MappingError::UnknownLandmark {
+                path: path.into(),
+                key: key.clone(),
+                valid: Landmark::all().map(Landmark::name).collect::<Vec<_>>().join(", "),
+            })?;
             let (joint, end_site) = match &value {
                 toml::Value::String(s) => (s.clone(), false),
                 toml::Value::Table(t) if t.len() == 1 => match t.get("end_of") {
                     Some(toml::Value::String(s)) => (s.clone(), true),
                     _ => {
-                        return Err(MappingError::BadValue {
-                            path: path.into(),
-                            key,
-                        });
+                        return Err(MappingError::BadValue { path: path.into(), key });
                     }
                 },
                 _ => {
-                    return Err(MappingError::BadValue {
-                        path: path.into(),
-                        key,
-                    });
+                    return Err(MappingError::BadValue { path: path.into(), key });
                 }
             };
             entries.push((landmark, joint, end_site));
         }
-        Ok(UserMapping {
-            path: path.into(),
-            entries,
-        })
+        Ok(UserMapping { path: path.into(), entries })
     }
 }
 
@@ -407,10 +353,7 @@ impl UserMapping {
 /// gives one, else the built-in scheme that maps the most required
 /// landmarks (then the most landmarks). Only the first root's hierarchy is
 /// searched.
-pub fn map_skeleton(
-    skeleton: &Skeleton,
-    user: Option<&UserMapping>,
-) -> Result<Mapping, MappingError> {
+pub fn map_skeleton(skeleton: &Skeleton, user: Option<&UserMapping>) -> Result<Mapping, MappingError> {
     let first_root = skeleton.roots().next().unwrap_or(0);
     let in_body = |j: usize| skeleton.is_ancestor_or_self(first_root, j);
     let mut best: Option<Mapping> = None;
@@ -421,35 +364,24 @@ pub fn map_skeleton(
     for scheme in SCHEMES {
         let mut points = BTreeMap::new();
         for (landmark, candidates) in expand(scheme) {
-            if let Some(point) = candidates
-                .iter()
-                .find_map(|c| resolve(skeleton, c, &in_body))
-            {
+            if let Some(point) = candidates.iter().find_map(|c| resolve(skeleton, c, &in_body)) {
                 points.insert(landmark, point);
             }
         }
-        let mapping = Mapping {
-            scheme: scheme.name,
-            points,
-        };
+        let mapping = Mapping { scheme: scheme.name, points };
         if best.as_ref().is_none_or(|b| score(&mapping) > score(b)) {
             best = Some(mapping);
         }
     }
-    let mut mapping = best.unwrap_or(Mapping {
-        scheme: "none",
-        points: BTreeMap::new(),
-    });
+    let mut mapping = best.unwrap_or(Mapping { scheme: "none", points: BTreeMap::new() });
     if let Some(user) = user {
         for (landmark, joint, end_site) in &user.entries {
-            let index = skeleton
-                .find(joint)
-                .ok_or_else(|| MappingError::UnknownJoint {
-                    path: user.path.clone(),
-                    key: landmark.name().into(),
-                    joint: joint.clone(),
-                    available: joint_list(skeleton),
-                })?;
+            let index = skeleton.find(joint).ok_or_else(|| MappingError::UnknownJoint {
+                path: user.path.clone(),
+                key: landmark.name().into(),
+                joint: joint.clone(),
+                available: joint_list(skeleton),
+            })?;
             if *end_site && skeleton.joints[index].end_site.is_none() {
                 return Err(MappingError::NoEndSite {
                     path: user.path.clone(),
@@ -457,17 +389,9 @@ pub fn map_skeleton(
                     joint: joint.clone(),
                 });
             }
-            mapping.points.insert(
-                *landmark,
-                SourcePoint {
-                    joint: index,
-                    end_site: *end_site,
-                },
-            );
+            mapping.points.insert(*landmark, SourcePoint { joint: index, end_site: *end_site });
         }
-        if user.entries.len() >= Landmark::all().count()
-            || mapping.points.len() == user.entries.len()
-        {
+        if user.entries.len() >= Landmark::all().count() || mapping.points.len() == user.entries.len() {
             mapping.scheme = "user";
         }
     }
@@ -476,12 +400,7 @@ pub fn map_skeleton(
 
 /// The source joints' names, for messages.
 pub fn joint_list(skeleton: &Skeleton) -> String {
-    skeleton
-        .joints
-        .iter()
-        .map(|j| j.name.as_str())
-        .collect::<Vec<_>>()
-        .join(", ")
+    skeleton.joints.iter().map(|j| j.name.as_str()).collect::<Vec<_>>().join(", ")
 }
 
 /// A scheme's entries with `*` expanded to both sides.
@@ -490,12 +409,8 @@ fn expand(scheme: &Scheme) -> Vec<(Landmark, Vec<String>)> {
     for (key, names) in scheme.entries {
         if let Some(rest) = key.strip_prefix('*') {
             for (side, prefix) in [("left", "Left"), ("right", "Right")] {
-                let landmark = Landmark::from_name(&format!("{side}{rest}"))
-                    .expect("scheme keys are landmarks");
-                out.push((
-                    landmark,
-                    names.iter().map(|n| n.replace('*', prefix)).collect(),
-                ));
+                let landmark = Landmark::from_name(&format!("{side}{rest}")).expect("scheme keys are landmarks");
+                out.push((landmark, names.iter().map(|n| n.replace('*', prefix)).collect()));
             }
         } else {
             let landmark = Landmark::from_name(key).expect("scheme keys are landmarks");
@@ -507,11 +422,7 @@ fn expand(scheme: &Scheme) -> Vec<(Landmark, Vec<String>)> {
 
 /// Finds a candidate name: exactly, or ignoring case and any namespace
 /// prefix (`mixamorig:Hips`, `Armature|Hips`).
-fn resolve(
-    skeleton: &Skeleton,
-    candidate: &str,
-    in_body: &impl Fn(usize) -> bool,
-) -> Option<SourcePoint> {
+fn resolve(skeleton: &Skeleton, candidate: &str, in_body: &impl Fn(usize) -> bool) -> Option<SourcePoint> {
     let (name, end_site) = match candidate.strip_prefix("end:") {
         Some(n) => (n, true),
         None => (candidate, false),
@@ -519,17 +430,11 @@ fn resolve(
     let joints = &skeleton.joints;
     let found = (0..joints.len())
         .find(|&j| in_body(j) && joints[j].name == name)
-        .or_else(|| {
-            (0..joints.len())
-                .find(|&j| in_body(j) && base_name(&joints[j].name).eq_ignore_ascii_case(name))
-        })?;
+        .or_else(|| (0..joints.len()).find(|&j| in_body(j) && base_name(&joints[j].name).eq_ignore_ascii_case(name)))?;
     if end_site && joints[found].end_site.is_none() {
         return None;
     }
-    Some(SourcePoint {
-        joint: found,
-        end_site,
-    })
+    Some(SourcePoint { joint: found, end_site })
 }
 
 fn base_name(name: &str) -> &str {
@@ -581,13 +486,7 @@ mod tests {
         assert_eq!(m.scheme, "mixamo");
         assert!(m.missing_required().is_empty());
         assert_eq!(m.get(Landmark::Joint(Joint::Chest)).unwrap().joint, 3);
-        assert_eq!(
-            m.get(Landmark::HeadTop),
-            Some(SourcePoint {
-                joint: 11,
-                end_site: true
-            })
-        );
+        assert_eq!(m.get(Landmark::HeadTop), Some(SourcePoint { joint: 11, end_site: true }));
     }
 
     #[test]
@@ -598,67 +497,29 @@ mod tests {
         // spine below it, and there are no arms at all.
         assert_eq!(
             missing,
-            [
-                "spine",
-                "left_shoulder",
-                "left_elbow",
-                "left_wrist",
-                "right_shoulder",
-                "right_elbow",
-                "right_wrist"
-            ]
+            ["spine", "left_shoulder", "left_elbow", "left_wrist", "right_shoulder", "right_elbow", "right_wrist"]
         );
     }
 
     #[test]
     fn a_user_mapping_overrides_and_completes_the_built_in_scheme() {
-        let names = [
-            "Bip01 Pelvis",
-            "Bip01 Spine",
-            "Waist",
-            "Bip01 Neck",
-            "Bip01 Head",
-        ];
-        let user = UserMapping::parse(
-            "chest = \"Waist\"\nhead_top = { end_of = \"Bip01 Head\" }\n",
-            "m.toml",
-        )
-        .unwrap();
+        let names = ["Bip01 Pelvis", "Bip01 Spine", "Waist", "Bip01 Neck", "Bip01 Head"];
+        let user = UserMapping::parse("chest = \"Waist\"\nhead_top = { end_of = \"Bip01 Head\" }\n", "m.toml").unwrap();
         let m = map_skeleton(&skeleton(&names), Some(&user)).unwrap();
         assert_eq!(m.get(Landmark::Joint(Joint::Chest)).unwrap().joint, 2);
-        assert_eq!(
-            m.get(Landmark::HeadTop),
-            Some(SourcePoint {
-                joint: 4,
-                end_site: true
-            })
-        );
+        assert_eq!(m.get(Landmark::HeadTop), Some(SourcePoint { joint: 4, end_site: true }));
     }
 
     #[test]
     fn user_mapping_errors_name_the_file_and_the_problem() {
-        let err = UserMapping::parse("elbow = \"X\"", "m.toml")
-            .unwrap_err()
-            .to_string();
-        assert!(
-            err.starts_with("m.toml: `elbow` is not a canonical joint"),
-            "{err}"
-        );
-        let err = UserMapping::parse("chest = 3", "m.toml")
-            .unwrap_err()
-            .to_string();
+        let err = UserMapping::parse("elbow = \"X\"", "m.toml").unwrap_err().to_string();
+        assert!(err.starts_with("m.toml: `elbow` is not a canonical joint"), "{err}");
+        let err = UserMapping::parse("chest = 3", "m.toml").unwrap_err().to_string();
         assert!(err.contains("must be a joint name"), "{err}");
         let user = UserMapping::parse("chest = \"Nope\"", "m.toml").unwrap();
-        let err = map_skeleton(&skeleton(&["Hips"]), Some(&user))
-            .unwrap_err()
-            .to_string();
-        assert!(
-            err.contains("no joint `Nope`") && err.contains("Hips"),
-            "{err}"
-        );
-        let err = UserMapping::parse("chest = [", "m.toml")
-            .unwrap_err()
-            .to_string();
+        let err = map_skeleton(&skeleton(&["Hips"]), Some(&user)).unwrap_err().to_string();
+        assert!(err.contains("no joint `Nope`") && err.contains("Hips"), "{err}");
+        let err = UserMapping::parse("chest = [", "m.toml").unwrap_err().to_string();
         assert!(err.starts_with("m.toml: not valid TOML"), "{err}");
     }
 }

@@ -47,11 +47,7 @@ impl BodyFrame {
 impl Pose {
     /// The rest pose standing at the origin.
     pub fn rest(body: &Body) -> Pose {
-        Pose {
-            root: DVec3::new(0.0, body.pelvis_height(), 0.0),
-            heading: 0.0,
-            x: [0.0; DOF],
-        }
+        Pose { root: DVec3::new(0.0, body.pelvis_height(), 0.0), heading: 0.0, x: [0.0; DOF] }
     }
 
     /// This joint's numbers in `x`.
@@ -67,11 +63,7 @@ impl Pose {
             Kind::Hinge { axis, .. } => DQuat::from_axis_angle(axis, v[0]),
             Kind::Ball { .. } => exp_map(DVec3::new(v[0], v[1], v[2])),
         };
-        if j == Joint::Pelvis {
-            Axis::Y.rotation(self.heading) * q
-        } else {
-            q
-        }
+        if j == Joint::Pelvis { Axis::Y.rotation(self.heading) * q } else { q }
     }
 
     /// The pose with these joint rotations: each relative to its parent, the
@@ -116,10 +108,7 @@ impl Body {
                 }
             }
         }
-        BodyFrame {
-            positions,
-            rotations,
-        }
+        BodyFrame { positions, rotations }
     }
 }
 
@@ -141,19 +130,11 @@ impl Motion {
         for j in Joint::ALL {
             let rotations = j.euler_order().0.map(Channel::Rotation);
             let channels: Vec<Channel> = if j == Joint::Pelvis {
-                [Axis::X, Axis::Y, Axis::Z]
-                    .map(Channel::Position)
-                    .into_iter()
-                    .chain(rotations)
-                    .collect()
+                [Axis::X, Axis::Y, Axis::Z].map(Channel::Position).into_iter().chain(rotations).collect()
             } else {
                 rotations.to_vec()
             };
-            let offset = if j == Joint::Pelvis {
-                DVec3::ZERO
-            } else {
-                body.offset(j)
-            };
+            let offset = if j == Joint::Pelvis { DVec3::ZERO } else { body.offset(j) };
             joints.push(BvhJoint {
                 name: j.name().to_string(),
                 parent: j.parent().map(Joint::index),
@@ -212,10 +193,7 @@ mod tests {
         let back = Pose::from_rotations(pose.root, &rotations);
         for j in Joint::ALL {
             let (a, b) = (pose.local_rotation(j), back.local_rotation(j));
-            assert!(
-                crate::mocap::math::log_map(a.inverse() * b).length() < 1e-12,
-                "{j:?}"
-            );
+            assert!(crate::mocap::math::log_map(a.inverse() * b).length() < 1e-12, "{j:?}");
         }
         // The pelvis's tilt is measured after the heading, so converting
         // the canonical form again changes nothing.
@@ -244,10 +222,7 @@ mod tests {
             pose.x[j.dof_offset()] = 0.5;
         }
         let frame = body.forward(&pose);
-        for (elbow, wrist) in [
-            (Joint::LeftElbow, Joint::LeftWrist),
-            (Joint::RightElbow, Joint::RightWrist),
-        ] {
+        for (elbow, wrist) in [(Joint::LeftElbow, Joint::LeftWrist), (Joint::RightElbow, Joint::RightWrist)] {
             assert!((frame.position(wrist) - frame.position(elbow)).z > 0.1);
         }
         assert!((frame.position(Joint::LeftAnkle) - frame.position(Joint::LeftKnee)).z < -0.1);

@@ -19,9 +19,7 @@ use crate::mocap::body::{Body, JOINTS, Joint, Kind};
 use crate::mocap::bvh::{Bvh, Warning};
 use crate::mocap::fk::{Kinematics, PositionMode, Transform, sample_frames};
 use crate::mocap::math::{Axis, frame_from_directions, smoothstep5};
-use crate::mocap::names::{
-    Landmark, Mapping, MappingError, SourcePoint, UserMapping, joint_list, map_skeleton,
-};
+use crate::mocap::names::{Landmark, Mapping, MappingError, SourcePoint, UserMapping, joint_list, map_skeleton};
 use crate::mocap::pose::{Motion, Pose};
 use glam::{DMat3, DQuat, DVec3};
 use rayon::prelude::*;
@@ -88,11 +86,7 @@ pub enum RetargetError {
     #[error(transparent)]
     Mapping(#[from] MappingError),
     #[error("{}", unmapped_message(.scheme, .missing, .joints))]
-    Unmapped {
-        scheme: &'static str,
-        missing: Vec<&'static str>,
-        joints: String,
-    },
+    Unmapped { scheme: &'static str, missing: Vec<&'static str>, joints: String },
     #[error("the file has no frames of motion to retarget")]
     NoFrames,
     #[error("the skeleton has no length: its mapped joints all sit at one point")]
@@ -100,10 +94,7 @@ pub enum RetargetError {
 }
 
 fn unmapped_message(scheme: &str, missing: &[&str], joints: &str) -> String {
-    let example: String = missing
-        .iter()
-        .map(|m| format!("    {m} = \"<source joint name>\"\n"))
-        .collect();
+    let example: String = missing.iter().map(|m| format!("    {m} = \"<source joint name>\"\n")).collect();
     format!(
         "cannot map the skeleton onto the canonical body: no source joint for {} (closest built-in naming scheme: {scheme}).\n\
          Write a mapping file naming the source joint for each, and pass it with --map:\n\
@@ -144,30 +135,10 @@ struct Limb {
 }
 
 const LIMBS: [Limb; 4] = [
-    Limb {
-        parent: Joint::Chest,
-        root: Joint::LeftShoulder,
-        hinge: Joint::LeftElbow,
-        end: Joint::LeftWrist,
-    },
-    Limb {
-        parent: Joint::Chest,
-        root: Joint::RightShoulder,
-        hinge: Joint::RightElbow,
-        end: Joint::RightWrist,
-    },
-    Limb {
-        parent: Joint::Pelvis,
-        root: Joint::LeftHip,
-        hinge: Joint::LeftKnee,
-        end: Joint::LeftAnkle,
-    },
-    Limb {
-        parent: Joint::Pelvis,
-        root: Joint::RightHip,
-        hinge: Joint::RightKnee,
-        end: Joint::RightAnkle,
-    },
+    Limb { parent: Joint::Chest, root: Joint::LeftShoulder, hinge: Joint::LeftElbow, end: Joint::LeftWrist },
+    Limb { parent: Joint::Chest, root: Joint::RightShoulder, hinge: Joint::RightElbow, end: Joint::RightWrist },
+    Limb { parent: Joint::Pelvis, root: Joint::LeftHip, hinge: Joint::LeftKnee, end: Joint::LeftAnkle },
+    Limb { parent: Joint::Pelvis, root: Joint::RightHip, hinge: Joint::RightKnee, end: Joint::RightAnkle },
 ];
 
 /// For the limb ends: the tip that gives their direction and the landmark
@@ -235,11 +206,7 @@ impl Retargeter {
             points[l.slot()] = Some(*p);
         }
         let needed = kin.with_ancestors(points.iter().flatten().map(|p| p.joint));
-        let end_offsets = skeleton
-            .joints
-            .iter()
-            .map(|j| j.end_site.unwrap_or(DVec3::ZERO))
-            .collect();
+        let end_offsets = skeleton.joints.iter().map(|j| j.end_site.unwrap_or(DVec3::ZERO)).collect();
         let body = Body::standard();
         let mut r = Retargeter {
             kin,
@@ -289,11 +256,7 @@ impl Retargeter {
                 |scratch, frame| self.pose(frame, scratch),
             )
             .collect();
-        Motion {
-            body: self.body.clone(),
-            frame_time_s: bvh.frame_time_s,
-            poses,
-        }
+        Motion { body: self.body.clone(), frame_time_s: bvh.frame_time_s, poses }
     }
 
     /// The canonical pose for one frame of channel values. `scratch` holds
@@ -311,11 +274,7 @@ impl Retargeter {
 
     /// Source landmark positions for one frame in the canonical world
     /// (Y up, meters), for checking a retargeted pose against its source.
-    pub fn source_landmarks(
-        &self,
-        frame: &[f64],
-        scratch: &mut [Transform],
-    ) -> [Option<DVec3>; Landmark::COUNT] {
+    pub fn source_landmarks(&self, frame: &[f64], scratch: &mut [Transform]) -> [Option<DVec3>; Landmark::COUNT] {
         let source = self.source_frame(frame, scratch);
         source.p.map(|p| p.map(|v| v * self.scale))
     }
@@ -327,11 +286,7 @@ impl Retargeter {
         for (k, point) in self.points.iter().enumerate() {
             if let Some(point) = point {
                 let t = scratch[point.joint];
-                let local = if point.end_site {
-                    t.rotation * self.end_offsets[point.joint]
-                } else {
-                    DVec3::ZERO
-                };
+                let local = if point.end_site { t.rotation * self.end_offsets[point.joint] } else { DVec3::ZERO };
                 p[k] = Some(self.up * (t.position + local));
                 s[k] = Some(self.up * t.rotation);
             }
@@ -366,38 +321,12 @@ impl Retargeter {
         let lateral_chest = shoulder_line.unwrap_or(lateral_torso);
         let mixed = lateral_torso.normalize_or_zero() + lateral_chest.normalize_or_zero();
 
-        let pelvis_up = up_from(Pelvis, Spine)
-            .filter(|v| v.length() > 0.0)
-            .or(up_from(Pelvis, Chest));
-        w[Pelvis.index()] = orient(
-            DVec3::Y,
-            DVec3::X,
-            pelvis_up,
-            lateral_torso,
-            DQuat::IDENTITY,
-        );
-        w[Spine.index()] = orient(
-            DVec3::Y,
-            DVec3::X,
-            up_from(Spine, Chest),
-            mixed,
-            w[Pelvis.index()],
-        );
-        w[Chest.index()] = orient(
-            DVec3::Y,
-            DVec3::X,
-            up_from(Chest, Neck),
-            lateral_chest,
-            w[Spine.index()],
-        );
+        let pelvis_up = up_from(Pelvis, Spine).filter(|v| v.length() > 0.0).or(up_from(Pelvis, Chest));
+        w[Pelvis.index()] = orient(DVec3::Y, DVec3::X, pelvis_up, lateral_torso, DQuat::IDENTITY);
+        w[Spine.index()] = orient(DVec3::Y, DVec3::X, up_from(Spine, Chest), mixed, w[Pelvis.index()]);
+        w[Chest.index()] = orient(DVec3::Y, DVec3::X, up_from(Chest, Neck), lateral_chest, w[Spine.index()]);
         let neck_lateral = w[Chest.index()] * DVec3::X;
-        w[Neck.index()] = orient(
-            DVec3::Y,
-            DVec3::X,
-            up_from(Neck, Head),
-            neck_lateral,
-            w[Chest.index()],
-        );
+        w[Neck.index()] = orient(DVec3::Y, DVec3::X, up_from(Neck, Head), neck_lateral, w[Chest.index()]);
 
         // Head: its top gives the direction; its own frame the twist.
         let head_bone = self.body.bone(Head);
@@ -406,24 +335,16 @@ impl Retargeter {
             .zip(f.pj(Head))
             .map(|(top, head)| top - head)
             .or_else(|| Some(f.sj(Head)? * cal.end_bone[4]?));
-        let head_twist = f
-            .sj(Head)
-            .zip(cal.end_twist[4])
-            .map(|(s, v)| s * v)
-            .unwrap_or(neck_lateral);
+        let head_twist = f.sj(Head).zip(cal.end_twist[4]).map(|(s, v)| s * v).unwrap_or(neck_lateral);
         w[Head.index()] = orient(head_bone, DVec3::X, head_dir, head_twist, w[Neck.index()]);
 
         for (k, limb) in LIMBS.iter().enumerate() {
             let parent = w[limb.parent.index()];
-            let Kind::Hinge {
-                axis: rest_axis, ..
-            } = limb.hinge.kind()
-            else {
+            let Kind::Hinge { axis: rest_axis, .. } = limb.hinge.kind() else {
                 unreachable!("limb middles are hinges")
             };
             let bone = self.body.bone(limb.root);
-            let (Some(a), Some(b), Some(c)) = (f.pj(limb.root), f.pj(limb.hinge), f.pj(limb.end))
-            else {
+            let (Some(a), Some(b), Some(c)) = (f.pj(limb.root), f.pj(limb.hinge), f.pj(limb.end)) else {
                 // Unmapped leg: held at rest under its parent.
                 for j in [limb.root, limb.hinge, limb.end] {
                     w[j.index()] = parent;
@@ -442,11 +363,7 @@ impl Retargeter {
 
             let (tip, twist_landmark, rest_twist) = end_landmarks(limb.end);
             let s_end = f.sj(limb.end);
-            let dir = f
-                .p(tip)
-                .map(|t| t - c)
-                .filter(|d| d.length() > 0.0)
-                .or_else(|| Some(s_end? * cal.end_bone[k]?));
+            let dir = f.p(tip).map(|t| t - c).filter(|d| d.length() > 0.0).or_else(|| Some(s_end? * cal.end_bone[k]?));
             let twist = twist_landmark
                 .and_then(|l| f.p(l))
                 .map(|t| t - c)
@@ -454,40 +371,23 @@ impl Retargeter {
                 .unwrap_or(hinge * rest_twist);
             w[limb.end.index()] = orient(self.body.bone(limb.end), rest_twist, dir, twist, hinge);
         }
-        Solved {
-            rotations: w,
-            hinge_angles,
-        }
+        Solved { rotations: w, hinge_angles }
     }
 
-    fn analyse(
-        &mut self,
-        bvh: &Bvh,
-        mapping: &Mapping,
-        options: &RetargetOptions,
-    ) -> Result<(), RetargetError> {
+    fn analyse(&mut self, bvh: &Bvh, mapping: &Mapping, options: &RetargetOptions) -> Result<(), RetargetError> {
         let skeleton = &bvh.skeleton;
         // Sampled frames in the file's own axes: tips, up axis, proportions.
         let samples = sample_frames(bvh.frames);
         let mut scratch = vec![Transform::default(); skeleton.joints.len()];
-        let frames: Vec<SourceFrame> = samples
-            .iter()
-            .map(|&s| self.source_frame(bvh.frame(s), &mut scratch))
-            .collect();
+        let frames: Vec<SourceFrame> = samples.iter().map(|&s| self.source_frame(bvh.frame(s), &mut scratch)).collect();
         for (tip, deviation) in implausible_tips(&frames, &self.body) {
-            let source = mapping
-                .get(tip)
-                .map(|p| p.describe(skeleton))
-                .unwrap_or_default();
+            let source = mapping.get(tip).map(|p| p.describe(skeleton)).unwrap_or_default();
             self.points[tip.slot()] = None;
             let message = format!(
                 "`{tip}` ({source}) lies {deviation:.0}° from where a {tip} would be relative to its bone on average; \
                  it is ignored and that part is oriented from its source joint's frame"
             );
-            self.analysis.warnings.push(Warning {
-                code: "landmark_ignored",
-                message,
-            });
+            self.analysis.warnings.push(Warning { code: "landmark_ignored", message });
         }
         let a = &mut self.analysis;
         a.mapping = Landmark::all()
@@ -496,9 +396,7 @@ impl Retargeter {
                 source: self.points[l.slot()].map(|p| p.describe(skeleton)),
             })
             .collect();
-        let missing: Vec<Landmark> = Landmark::all()
-            .filter(|l| self.points[l.slot()].is_none())
-            .collect();
+        let missing: Vec<Landmark> = Landmark::all().filter(|l| self.points[l.slot()].is_none()).collect();
         a.missing = missing.iter().map(|l| l.name()).collect();
         for (j, joint) in skeleton.joints.iter().enumerate() {
             if joint.parent.is_some()
@@ -524,19 +422,9 @@ impl Retargeter {
         a.meters_per_unit = meters_per_unit;
 
         if a.up_axis != "+Y" {
-            let how = if a.up_detected {
-                "detected from the skeleton"
-            } else {
-                "set by --up"
-            };
-            let message = format!(
-                "the capture stands along {} ({how}); it is turned to stand along +Y",
-                a.up_axis
-            );
-            a.warnings.push(Warning {
-                code: "up_axis",
-                message,
-            });
+            let how = if a.up_detected { "detected from the skeleton" } else { "set by --up" };
+            let message = format!("the capture stands along {} ({how}); it is turned to stand along +Y", a.up_axis);
+            a.warnings.push(Warning { code: "up_axis", message });
         }
         if units == "unknown" {
             let message = format!(
@@ -544,10 +432,7 @@ impl Retargeter {
                  the body is scaled to {:.2} m",
                 Body::STANDARD_HEIGHT_M
             );
-            a.warnings.push(Warning {
-                code: "units_unknown",
-                message,
-            });
+            a.warnings.push(Warning { code: "units_unknown", message });
         }
         let legs: Vec<&str> = missing
             .iter()
@@ -555,14 +440,8 @@ impl Retargeter {
             .map(|l| l.name())
             .collect();
         if !legs.is_empty() {
-            let message = format!(
-                "no source joints for {}: those legs stay in the rest pose",
-                legs.join(", ")
-            );
-            a.warnings.push(Warning {
-                code: "legs_unmapped",
-                message,
-            });
+            let message = format!("no source joints for {}: those legs stay in the rest pose", legs.join(", "));
+            a.warnings.push(Warning { code: "legs_unmapped", message });
         }
         let extras: Vec<&str> = missing
             .iter()
@@ -574,20 +453,14 @@ impl Retargeter {
                 "no source points for {}: the head, hands and feet take that direction from their source joint's own frame",
                 extras.join(", ")
             );
-            a.warnings.push(Warning {
-                code: "landmarks_unmapped",
-                message,
-            });
+            a.warnings.push(Warning { code: "landmarks_unmapped", message });
         }
         for (name, mode) in &a.position_channels {
             if *mode == PositionMode::Absolute {
                 let message = format!(
                     "joint `{name}` has position channels that hold its whole local position (they equal its OFFSET); read as absolute"
                 );
-                a.warnings.push(Warning {
-                    code: "absolute_position_channels",
-                    message,
-                });
+                a.warnings.push(Warning { code: "absolute_position_channels", message });
             }
         }
         if mapping.scheme == "canonical" {
@@ -612,10 +485,7 @@ impl Retargeter {
         }
         let samples = sample_frames(bvh.frames);
         let mut scratch = vec![Transform::default(); bvh.skeleton.joints.len()];
-        let frames: Vec<SourceFrame> = samples
-            .iter()
-            .map(|&s| self.source_frame(bvh.frame(s), &mut scratch))
-            .collect();
+        let frames: Vec<SourceFrame> = samples.iter().map(|&s| self.source_frame(bvh.frame(s), &mut scratch)).collect();
 
         // Hinge axes: the line the bend-plane normals (seen from the limb
         // root's frame, weighted by how clearly the limb is bent) cluster
@@ -627,18 +497,8 @@ impl Retargeter {
             let normals: Vec<DVec3> = frames
                 .iter()
                 .filter_map(|f| {
-                    let (a, b, c, s) = (
-                        f.pj(limb.root)?,
-                        f.pj(limb.hinge)?,
-                        f.pj(limb.end)?,
-                        f.sj(limb.root)?,
-                    );
-                    Some(
-                        s.inverse()
-                            * (b - a)
-                                .normalize_or_zero()
-                                .cross((c - b).normalize_or_zero()),
-                    )
+                    let (a, b, c, s) = (f.pj(limb.root)?, f.pj(limb.hinge)?, f.pj(limb.end)?, f.sj(limb.root)?);
+                    Some(s.inverse() * (b - a).normalize_or_zero().cross((c - b).normalize_or_zero()))
                 })
                 .collect();
             cal.hinge[k] = dominant_axis(&normals);
@@ -679,9 +539,7 @@ impl Retargeter {
 /// Σ v vᵀ, by power iteration), signed to agree with most of them
 /// (weighted by length). `None` when they are all zero.
 fn dominant_axis(vectors: &[DVec3]) -> Option<DVec3> {
-    let scatter = vectors.iter().fold(DMat3::ZERO, |m, v| {
-        m + DMat3::from_cols(*v * v.x, *v * v.y, *v * v.z)
-    });
+    let scatter = vectors.iter().fold(DMat3::ZERO, |m, v| m + DMat3::from_cols(*v * v.x, *v * v.y, *v * v.z));
     // Start from the column with the most weight: never orthogonal to the
     // top eigenvector unless the scatter is zero.
     let mut axis = [scatter.x_axis, scatter.y_axis, scatter.z_axis]
@@ -756,9 +614,11 @@ fn hinge_axis(u: DVec3, v: DVec3, calibrated: Option<DVec3>) -> Option<DVec3> {
     let exact = cross / sin;
     let agreement = exact.dot(fallback);
     let w = smoothstep5(sin / STRAIGHT_SIN);
-    (exact * (w * agreement) + fallback * (1.0 - w))
-        .try_normalize()
-        .or(Some(if agreement < 0.0 { -exact } else { exact }))
+    (exact * (w * agreement) + fallback * (1.0 - w)).try_normalize().or(Some(if agreement < 0.0 {
+        -exact
+    } else {
+        exact
+    }))
 }
 
 /// Angle from `u` to `v` about `axis` (right-handed), in (−π, π].
@@ -773,12 +633,8 @@ fn local_rotations(world: &[DQuat; JOINTS], hinge_angles: &[f64; JOINTS]) -> [DQ
     for j in Joint::ALL {
         local[j.index()] = match (j.parent(), j.kind()) {
             (None, _) => world[j.index()],
-            (Some(_), Kind::Hinge { axis, .. }) => {
-                DQuat::from_axis_angle(axis, hinge_angles[j.index()])
-            }
-            (Some(p), Kind::Ball { .. }) => {
-                (world[p.index()].inverse() * world[j.index()]).normalize()
-            }
+            (Some(_), Kind::Hinge { axis, .. }) => DQuat::from_axis_angle(axis, hinge_angles[j.index()]),
+            (Some(p), Kind::Ball { .. }) => (world[p.index()].inverse() * world[j.index()]).normalize(),
         };
     }
     local
@@ -792,18 +648,13 @@ fn detect_up(frames: &[SourceFrame]) -> (DVec3, String) {
         let Some(head) = f.pj(Joint::Head) else {
             continue;
         };
-        let feet = f
-            .pj(Joint::LeftAnkle)
-            .zip(f.pj(Joint::RightAnkle))
-            .map(|(l, r)| 0.5 * (l + r));
+        let feet = f.pj(Joint::LeftAnkle).zip(f.pj(Joint::RightAnkle)).map(|(l, r)| 0.5 * (l + r));
         if let Some(base) = feet.or(f.pj(Joint::Pelvis)) {
             sum += (head - base).normalize_or_zero();
         }
     }
-    let axis = Axis::ALL
-        .into_iter()
-        .max_by(|a, b| sum[a.index()].abs().total_cmp(&sum[b.index()].abs()))
-        .unwrap_or(Axis::Y);
+    let axis =
+        Axis::ALL.into_iter().max_by(|a, b| sum[a.index()].abs().total_cmp(&sum[b.index()].abs())).unwrap_or(Axis::Y);
     let sign = if sum[axis.index()] < 0.0 { -1.0 } else { 1.0 };
     let name = format!("{}{}", if sign < 0.0 { '-' } else { '+' }, axis.letter());
     (axis.unit() * sign, name)
@@ -901,12 +752,7 @@ fn implausible_tips(frames: &[SourceFrame], body: &Body) -> Vec<(Landmark, f64)>
 /// stature, and meters per unit; else `unknown`, scaled to a standard body.
 fn detect_units(height: f64) -> (&'static str, f64) {
     let (lo, hi) = HEIGHT_RANGE_M;
-    for (name, meters) in [
-        ("meters", 1.0),
-        ("centimeters", 0.01),
-        ("millimeters", 0.001),
-        ("inches", 0.0254),
-    ] {
+    for (name, meters) in [("meters", 1.0), ("centimeters", 0.01), ("millimeters", 0.001), ("inches", 0.0254)] {
         let h = height * meters;
         if (lo..=hi).contains(&h) {
             return (name, meters);
@@ -927,20 +773,10 @@ fn canonical_joints(bvh: &Bvh, body: &Body) -> Option<[usize; JOINTS]> {
         if joint.parent != j.parent().map(|p| map[p.index()]) {
             return None;
         }
-        if j != Joint::Pelvis
-            && joint
-                .offset
-                .normalize_or_zero()
-                .dot(body.offset(j).normalize())
-                < 0.9995
-        {
+        if j != Joint::Pelvis && joint.offset.normalize_or_zero().dot(body.offset(j).normalize()) < 0.9995 {
             return None;
         }
-        let rotations = joint
-            .channels
-            .iter()
-            .filter(|c| matches!(c, crate::mocap::bvh::Channel::Rotation(_)))
-            .count();
+        let rotations = joint.channels.iter().filter(|c| matches!(c, crate::mocap::bvh::Channel::Rotation(_))).count();
         if rotations != 3 || joint.euler_order().is_none() {
             return None;
         }
@@ -1001,12 +837,7 @@ impl DirectionErrors {
             .filter(|(b, _)| counts[*b] > 0)
             .map(|(b, (name, _, _))| (*name, sums[b] / counts[b] as f64))
             .collect();
-        let mean_deg =
-            per_bone_deg.iter().map(|(_, d)| d).sum::<f64>() / per_bone_deg.len().max(1) as f64;
-        DirectionErrors {
-            per_bone_deg,
-            mean_deg,
-            max_deg,
-        }
+        let mean_deg = per_bone_deg.iter().map(|(_, d)| d).sum::<f64>() / per_bone_deg.len().max(1) as f64;
+        DirectionErrors { per_bone_deg, mean_deg, max_deg }
     }
 }

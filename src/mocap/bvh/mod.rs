@@ -87,9 +87,7 @@ impl Joint {
     }
 
     pub fn has_position_channels(&self) -> bool {
-        self.channels
-            .iter()
-            .any(|c| matches!(c, Channel::Position(_)))
+        self.channels.iter().any(|c| matches!(c, Channel::Position(_)))
     }
 }
 
@@ -111,20 +109,12 @@ impl Skeleton {
     }
 
     pub fn roots(&self) -> impl Iterator<Item = usize> + '_ {
-        self.joints
-            .iter()
-            .enumerate()
-            .filter(|(_, j)| j.parent.is_none())
-            .map(|(i, _)| i)
+        self.joints.iter().enumerate().filter(|(_, j)| j.parent.is_none()).map(|(i, _)| i)
     }
 
     /// Indices of the children of joint `i`, in declaration order.
     pub fn children(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
-        self.joints
-            .iter()
-            .enumerate()
-            .filter(move |(_, j)| j.parent == Some(i))
-            .map(|(c, _)| c)
+        self.joints.iter().enumerate().filter(move |(_, j)| j.parent == Some(i)).map(|(c, _)| c)
     }
 
     /// True when `ancestor` is `joint` or lies on its path to the root.
@@ -210,27 +200,19 @@ pub enum BvhErrorKind {
     #[error("not a BVH file: expected `HIERARCHY`, found {found}")]
     NotBvh { found: String },
     #[error("expected {expected}, found {found}")]
-    Expected {
-        expected: &'static str,
-        found: String,
-    },
+    Expected { expected: &'static str, found: String },
     #[error("unexpected end of file {context}")]
     UnexpectedEof { context: String },
     #[error("line is longer than {limit} bytes; a BVH hierarchy line never is (binary data?)")]
     LineTooLong { limit: usize },
     #[error("{what}: `{token}` is not a number")]
     BadNumber { what: String, token: String },
-    #[error(
-        "unknown channel `{token}` (expected Xposition, Yposition, Zposition, Xrotation, Yrotation or Zrotation)"
-    )]
+    #[error("unknown channel `{token}` (expected Xposition, Yposition, Zposition, Xrotation, Yrotation or Zrotation)")]
     UnknownChannel { token: String },
     #[error("CHANNELS declares {declared} channels but lists {listed}")]
     ChannelCount { declared: usize, listed: usize },
     #[error("joint `{joint}` lists {channel} twice")]
-    RepeatedChannel {
-        joint: String,
-        channel: &'static str,
-    },
+    RepeatedChannel { joint: String, channel: &'static str },
     #[error("`}}` without a matching `{{`")]
     UnbalancedClose,
     #[error("the hierarchy has no joints")]
@@ -241,34 +223,12 @@ pub enum BvhErrorKind {
     BadFrameCount { token: String },
     #[error("frame time `{token}` is not a positive number of seconds")]
     BadFrameTime { token: String },
-    #[error(
-        "frame {frame}, channel {channel} ({joint} {channel_name}): value `{token}` is not finite"
-    )]
-    NonFinite {
-        frame: usize,
-        channel: usize,
-        joint: String,
-        channel_name: &'static str,
-        token: String,
-    },
+    #[error("frame {frame}, channel {channel} ({joint} {channel_name}): value `{token}` is not finite")]
+    NonFinite { frame: usize, channel: usize, joint: String, channel_name: &'static str, token: String },
     #[error("frame {frame}, channel {channel} ({joint} {channel_name}): `{token}` is not a number")]
-    NonNumeric {
-        frame: usize,
-        channel: usize,
-        joint: String,
-        channel_name: &'static str,
-        token: String,
-    },
+    NonNumeric { frame: usize, channel: usize, joint: String, channel_name: &'static str, token: String },
     #[error("frame {frame} has {found} values, expected {expected} (one per channel)")]
-    WrongValueCount {
-        frame: usize,
-        found: usize,
-        expected: usize,
-    },
+    WrongValueCount { frame: usize, found: usize, expected: usize },
     #[error("file ends mid-frame: frame {frame} has {found} of {expected} values")]
-    TruncatedFrame {
-        frame: usize,
-        found: usize,
-        expected: usize,
-    },
+    TruncatedFrame { frame: usize, found: usize, expected: usize },
 }

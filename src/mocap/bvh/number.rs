@@ -5,8 +5,8 @@
 //! rounded parser, so every value is the nearest f64 either way.
 
 const POW10: [f64; 23] = [
-    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
-    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20,
+    1e21, 1e22,
 ];
 
 /// Why a token could not be read as a finite number.
@@ -34,11 +34,7 @@ fn is_blank(b: u8) -> bool {
 /// index just past the line (past its `\n`). Values may be separated by
 /// spaces or tabs, or glued to the next value's sign (`0.0-7.509`).
 #[inline]
-pub(super) fn scan_line(
-    bytes: &[u8],
-    mut pos: usize,
-    out: &mut Vec<f64>,
-) -> Result<(usize, usize), TokenError> {
+pub(super) fn scan_line(bytes: &[u8], mut pos: usize, out: &mut Vec<f64>) -> Result<(usize, usize), TokenError> {
     let n = bytes.len();
     let mut count = 0;
     while pos < n {
@@ -82,25 +78,14 @@ pub(super) fn scan_fields(text: &str) -> Result<Vec<f64>, TokenError> {
 }
 
 fn token_error(bytes: &[u8], start: usize, index: usize) -> TokenError {
-    let end = bytes[start..]
-        .iter()
-        .position(|&b| b == b'\n' || is_blank(b))
-        .map_or(bytes.len(), |p| start + p);
+    let end = bytes[start..].iter().position(|&b| b == b'\n' || is_blank(b)).map_or(bytes.len(), |p| start + p);
     let raw = &bytes[start..end.min(start + 40)];
     let token = String::from_utf8_lossy(raw).into_owned();
     let word = token.trim_start_matches(['-', '+']).to_ascii_lowercase();
     // NaN, inf, infinity, and MSVC's 1.#IND / 1.#QNAN / 1.#INF spellings.
     let non_finite = word.starts_with("nan") || word.starts_with("inf") || word.contains('#');
-    let problem = if non_finite {
-        TokenProblem::NonFinite
-    } else {
-        TokenProblem::NonNumeric
-    };
-    TokenError {
-        index,
-        problem,
-        token,
-    }
+    let problem = if non_finite { TokenProblem::NonFinite } else { TokenProblem::NonNumeric };
+    TokenError { index, problem, token }
 }
 
 /// Parses `[+-] digits [. digits] [(e|E) [+-] digits]` at `*pos`, advancing
@@ -187,11 +172,7 @@ fn parse_number(s: &[u8], pos: &mut usize) -> Option<f64> {
     *pos = i;
     if !overflow && mantissa <= 1 << 53 && exp10.abs() <= 22 {
         let m = mantissa as f64;
-        let v = if exp10 < 0 {
-            m / POW10[(-exp10) as usize]
-        } else {
-            m * POW10[exp10 as usize]
-        };
+        let v = if exp10 < 0 { m / POW10[(-exp10) as usize] } else { m * POW10[exp10 as usize] };
         return Some(if negative { -v } else { v });
     }
     // The scanned bytes are ASCII digits, signs, '.', 'e' and 'E'.
@@ -218,10 +199,7 @@ mod tests {
 
     #[test]
     fn splits_values_glued_to_a_minus_sign() {
-        assert_eq!(
-            values("0.0-7.509 1.25-3-4").unwrap(),
-            vec![0.0, -7.509, 1.25, -3.0, -4.0]
-        );
+        assert_eq!(values("0.0-7.509 1.25-3-4").unwrap(), vec![0.0, -7.509, 1.25, -3.0, -4.0]);
     }
 
     #[test]
@@ -250,41 +228,21 @@ mod tests {
             "2.2250738585072011e-308",
         ];
         for text in cases {
-            assert_eq!(
-                values(text).unwrap(),
-                vec![text.parse::<f64>().unwrap()],
-                "{text}"
-            );
+            assert_eq!(values(text).unwrap(), vec![text.parse::<f64>().unwrap()], "{text}");
         }
     }
 
     #[test]
     fn nan_infinity_and_overflow_are_non_finite_errors_naming_the_value_index() {
-        for (line, index) in [
-            ("1 nan", 1),
-            ("-inf 2", 0),
-            ("1 2 1.#QNAN", 2),
-            ("1e400", 0),
-            ("NaN", 0),
-        ] {
+        for (line, index) in [("1 nan", 1), ("-inf 2", 0), ("1 2 1.#QNAN", 2), ("1e400", 0), ("NaN", 0)] {
             let err = values(line).unwrap_err();
-            assert_eq!(
-                (err.index, err.problem),
-                (index, TokenProblem::NonFinite),
-                "{line}"
-            );
+            assert_eq!((err.index, err.problem), (index, TokenProblem::NonFinite), "{line}");
         }
     }
 
     #[test]
     fn words_and_half_numbers_are_non_numeric_errors_with_their_token() {
-        for (line, token) in [
-            ("1 abc", "abc"),
-            ("1.0x 2", "1.0x"),
-            ("1e", "1e"),
-            ("--1", "--1"),
-            (".", "."),
-        ] {
+        for (line, token) in [("1 abc", "abc"), ("1.0x 2", "1.0x"), ("1e", "1e"), ("--1", "--1"), (".", ".")] {
             let err = values(line).unwrap_err();
             assert_eq!(err.problem, TokenProblem::NonNumeric, "{line}");
             assert_eq!(err.token, token);

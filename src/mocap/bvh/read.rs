@@ -23,11 +23,7 @@ const MAX_TOKEN: usize = 64;
 /// Reads a BVH file.
 pub fn read_bvh(path: &Path) -> Result<Bvh, BvhError> {
     let name = path.display().to_string();
-    let fail = |kind| BvhError {
-        path: name.clone(),
-        line: None,
-        kind: Box::new(kind),
-    };
+    let fail = |kind| BvhError { path: name.clone(), line: None, kind: Box::new(kind) };
     let meta = std::fs::metadata(path).map_err(|e| fail(BvhErrorKind::Io(e)))?;
     if meta.is_dir() {
         return Err(fail(BvhErrorKind::IsDirectory));
@@ -48,6 +44,9 @@ struct Reader<R> {
     path: String,
     /// Number of the last line read (1-based).
     line: usize,
+    /// Whether a line with content has been read: binary data before one
+    /// (after blank lines too) means the file is not BVH at all.
+    content_seen: bool,
     buf: Vec<u8>,
     warnings: Vec<Warning>,
 }
@@ -60,31 +59,17 @@ enum Open {
 
 impl<R: BufRead> Reader<R> {
     fn new(input: R, size: u64, path: String) -> Self {
-        Reader {
-            input,
-            size,
-            consumed: 0,
-            path,
-            line: 0,
-            buf: Vec::new(),
-            warnings: Vec::new(),
-        }
+        Reader { input, size, consumed: 0, path, line: 0, content_seen: false, buf: Vec::new(), warnings: Vec::new() }
     }
 
     fn error(&self, kind: BvhErrorKind) -> BvhError {
-        BvhError {
-            path: self.path.clone(),
-            line: Some(self.line),
-            kind: Box::new(kind),
-        }
+        BvhError { path: self.path.clone(), line: Some(self.line), kind: Box::new(kind) }
     }
 
-    /// Unreadable text: on the first line the file is simply not BVH.
+    /// Unreadable text: before any content the file is simply not BVH.
     fn binary(&self, kind: BvhErrorKind) -> BvhError {
-        if self.line <= 1 {
-            return self.error(BvhErrorKind::NotBvh {
-                found: "binary data".into(),
-            });
+        if !self.content_seen {
+            return self.error(BvhErrorKind::NotBvh { found: "binary data".into() });
         }
         self.error(kind)
     }
@@ -107,26 +92,19 @@ impl<R: BufRead> Reader<R> {
             self.consumed += read as u64;
             self.line += 1;
             if self.buf.len() > MAX_HIERARCHY_LINE {
-                return Err(self.binary(BvhErrorKind::LineTooLong {
-                    limit: MAX_HIERARCHY_LINE,
-                }));
+                return Err(self.binary(BvhErrorKind::LineTooLong { limit: MAX_HIERARCHY_LINE }));
             }
             let Ok(text) = std::str::from_utf8(&self.buf) else {
                 let found = "bytes that are not UTF-8 text".to_string();
-                return Err(self.binary(BvhErrorKind::Expected {
-                    expected: "BVH text",
-                    found,
-                }));
+                return Err(self.binary(BvhErrorKind::Expected { expected: "BVH text", found }));
             };
             let trimmed = text.trim_start_matches('\u{feff}').trim();
             if trimmed.contains('\0') {
                 let found = "binary data".to_string();
-                return Err(self.binary(BvhErrorKind::Expected {
-                    expected: "BVH text",
-                    found,
-                }));
+                return Err(self.binary(BvhErrorKind::Expected { expected: "BVH text", found }));
             }
             if !trimmed.is_empty() {
+                self.content_seen = true;
                 return Ok(Some(trimmed.to_string()));
             }
         }
@@ -136,17 +114,11 @@ impl<R: BufRead> Reader<R> {
         let first = match self.next_line()? {
             Some(l) => l,
             None => {
-                return Err(BvhError {
-                    path: self.path.clone(),
-                    line: None,
-                    kind: Box::new(BvhErrorKind::Empty),
-                });
+                return Err(BvhError { path: self.path.clone(), line: None, kind: Box::new(BvhErrorKind::Empty) });
             }
         };
         if !first.eq_ignore_ascii_case("hierarchy") {
-            return Err(self.error(BvhErrorKind::NotBvh {
-                found: quote(&first),
-            }));
+            return Err(self.error(BvhErrorKind::NotBvh { found: quote(&first) }));
         }
         let skeleton = self.read_hierarchy()?;
         let (declared_frames, frame_time_s) = self.read_motion_header()?;
@@ -154,17 +126,12 @@ impl<R: BufRead> Reader<R> {
         if frames as u64 != declared_frames {
             self.warn(
                 "frame_count_mismatch",
-                format!("the file declares {declared_frames} frames but holds {frames}; using the {frames} frames of data"),
+                format!(
+                    "the file declares {declared_frames} frames but holds {frames}; using the {frames} frames of data"
+                ),
             );
         }
-        Ok(Bvh {
-            skeleton,
-            frame_time_s,
-            data,
-            frames,
-            declared_frames,
-            warnings: self.warnings,
-        })
+        Ok(Bvh { skeleton, frame_time_s, data, frames, declared_frames, warnings: self.warnings })
     }
 
     fn read_hierarchy(&mut self) -> Result<Skeleton, BvhError> {
@@ -186,10 +153,7 @@ impl<R: BufRead> Reader<R> {
                         )
                     }
                     (None, Some(Open::EndSite { owner, .. })) => {
-                        format!(
-                            "in the hierarchy: the End Site of `{}` is not closed",
-                            joints[*owner].name
-                        )
+                        format!("in the hierarchy: the End Site of `{}` is not closed", joints[*owner].name)
                     }
                     (None, None) => "before MOTION".to_string(),
                 };
@@ -200,10 +164,7 @@ impl<R: BufRead> Reader<R> {
 
             if let Some(open) = awaiting_brace.take() {
                 if !keyword.starts_with('{') {
-                    return Err(self.error(BvhErrorKind::Expected {
-                        expected: "`{`",
-                        found: quote(&line),
-                    }));
+                    return Err(self.error(BvhErrorKind::Expected { expected: "`{`", found: quote(&line) }));
                 }
                 stack.push(open);
                 let after = line[1..].trim();
@@ -211,10 +172,9 @@ impl<R: BufRead> Reader<R> {
                     continue;
                 }
                 // `{ OFFSET ...` on one line: read the remainder as its own line.
-                return Err(self.error(BvhErrorKind::Expected {
-                    expected: "a line break after `{`",
-                    found: quote(after),
-                }));
+                return Err(
+                    self.error(BvhErrorKind::Expected { expected: "a line break after `{`", found: quote(after) })
+                );
             }
 
             match keyword_lower.as_str() {
@@ -230,23 +190,15 @@ impl<R: BufRead> Reader<R> {
                             }));
                         }
                         _ => {
-                            let expected = if is_root {
-                                "JOINT inside a joint"
-                            } else {
-                                "ROOT at the top level"
-                            };
-                            return Err(self.error(BvhErrorKind::Expected {
-                                expected,
-                                found: quote(&line),
-                            }));
+                            let expected = if is_root { "JOINT inside a joint" } else { "ROOT at the top level" };
+                            return Err(self.error(BvhErrorKind::Expected { expected, found: quote(&line) }));
                         }
                     };
                     let (name, brace) = strip_brace(rest);
                     if name.is_empty() {
-                        return Err(self.error(BvhErrorKind::Expected {
-                            expected: "a joint name",
-                            found: quote(&line),
-                        }));
+                        return Err(
+                            self.error(BvhErrorKind::Expected { expected: "a joint name", found: quote(&line) })
+                        );
                     }
                     if is_root {
                         roots += 1;
@@ -262,11 +214,7 @@ impl<R: BufRead> Reader<R> {
                     });
                     offset_seen.push(false);
                     let open = Open::Joint(joints.len() - 1);
-                    if brace {
-                        stack.push(open)
-                    } else {
-                        awaiting_brace = Some(open)
-                    }
+                    if brace { stack.push(open) } else { awaiting_brace = Some(open) }
                 }
                 "end" => {
                     let (site, brace) = strip_brace(rest);
@@ -279,23 +227,12 @@ impl<R: BufRead> Reader<R> {
                             }));
                         }
                     };
-                    let open = Open::EndSite {
-                        owner,
-                        offset: None,
-                    };
-                    if brace {
-                        stack.push(open)
-                    } else {
-                        awaiting_brace = Some(open)
-                    }
+                    let open = Open::EndSite { owner, offset: None };
+                    if brace { stack.push(open) } else { awaiting_brace = Some(open) }
                 }
                 "offset" => {
-                    let values = scan_fields(rest).map_err(|e| {
-                        self.error(BvhErrorKind::BadNumber {
-                            what: "OFFSET".into(),
-                            token: e.token,
-                        })
-                    })?;
+                    let values = scan_fields(rest)
+                        .map_err(|e| self.error(BvhErrorKind::BadNumber { what: "OFFSET".into(), token: e.token }))?;
                     let [x, y, z] = <[f64; 3]>::try_from(values).map_err(|v| {
                         self.error(BvhErrorKind::Expected {
                             expected: "three OFFSET values",
@@ -317,10 +254,7 @@ impl<R: BufRead> Reader<R> {
                         }
                         Some(Open::EndSite { offset: slot, .. }) => *slot = Some(offset),
                         None => {
-                            return Err(self.error(BvhErrorKind::Expected {
-                                expected: "ROOT",
-                                found: quote(&line),
-                            }));
+                            return Err(self.error(BvhErrorKind::Expected { expected: "ROOT", found: quote(&line) }));
                         }
                     }
                 }
@@ -335,18 +269,12 @@ impl<R: BufRead> Reader<R> {
                     let mut tokens = rest.split_whitespace();
                     let count_token = tokens.next().unwrap_or("");
                     let declared: usize = count_token.parse().map_err(|_| {
-                        self.error(BvhErrorKind::BadNumber {
-                            what: "channel count".into(),
-                            token: count_token.into(),
-                        })
+                        self.error(BvhErrorKind::BadNumber { what: "channel count".into(), token: count_token.into() })
                     })?;
                     let mut channels = Vec::with_capacity(declared.min(6));
                     for token in tokens {
-                        let channel = Channel::parse(token).ok_or_else(|| {
-                            self.error(BvhErrorKind::UnknownChannel {
-                                token: token.into(),
-                            })
-                        })?;
+                        let channel = Channel::parse(token)
+                            .ok_or_else(|| self.error(BvhErrorKind::UnknownChannel { token: token.into() }))?;
                         if channels.contains(&channel) {
                             return Err(self.error(BvhErrorKind::RepeatedChannel {
                                 joint: joints[j].name.clone(),
@@ -356,10 +284,7 @@ impl<R: BufRead> Reader<R> {
                         channels.push(channel);
                     }
                     if channels.len() != declared {
-                        return Err(self.error(BvhErrorKind::ChannelCount {
-                            declared,
-                            listed: channels.len(),
-                        }));
+                        return Err(self.error(BvhErrorKind::ChannelCount { declared, listed: channels.len() }));
                     }
                     if !joints[j].channels.is_empty() {
                         return Err(self.error(BvhErrorKind::Expected {
@@ -376,10 +301,7 @@ impl<R: BufRead> Reader<R> {
                     for token in line.split_whitespace() {
                         for c in token.chars() {
                             if c != '}' {
-                                return Err(self.error(BvhErrorKind::Expected {
-                                    expected: "`}`",
-                                    found: quote(&line),
-                                }));
+                                return Err(self.error(BvhErrorKind::Expected { expected: "`}`", found: quote(&line) }));
                             }
                             match stack.pop() {
                                 Some(Open::Joint(_)) => {}
@@ -425,10 +347,8 @@ impl<R: BufRead> Reader<R> {
         }
         for (j, seen) in offset_seen.iter().enumerate() {
             if !seen {
-                let message = format!(
-                    "joint `{}` (line {}) has no OFFSET; 0 0 0 is used",
-                    joints[j].name, joints[j].line
-                );
+                let message =
+                    format!("joint `{}` (line {}) has no OFFSET; 0 0 0 is used", joints[j].name, joints[j].line);
                 self.warn("missing_offset", message);
             }
         }
@@ -448,14 +368,8 @@ impl<R: BufRead> Reader<R> {
         let mut frame_time = None;
         while frames.is_none() || frame_time.is_none() {
             let Some(line) = self.next_line()? else {
-                let context = if frames.is_none() {
-                    "before `Frames:`"
-                } else {
-                    "before `Frame Time:`"
-                };
-                return Err(self.error(BvhErrorKind::UnexpectedEof {
-                    context: context.into(),
-                }));
+                let context = if frames.is_none() { "before `Frames:`" } else { "before `Frame Time:`" };
+                return Err(self.error(BvhErrorKind::UnexpectedEof { context: context.into() }));
             };
             let lower = line.to_ascii_lowercase();
             if let Some(rest) = lower.strip_prefix("frame time") {
@@ -467,31 +381,19 @@ impl<R: BufRead> Reader<R> {
                 frame_time = Some(value);
             } else if let Some(rest) = lower.strip_prefix("frames") {
                 let text = rest.trim_start().trim_start_matches(':').trim();
-                let count: u64 = text
-                    .parse()
-                    .map_err(|_| self.error(BvhErrorKind::BadFrameCount { token: text.into() }))?;
+                let count: u64 =
+                    text.parse().map_err(|_| self.error(BvhErrorKind::BadFrameCount { token: text.into() }))?;
                 frames = Some(count);
             } else {
-                let expected = if frames.is_none() {
-                    "`Frames: N`"
-                } else {
-                    "`Frame Time: SECONDS`"
-                };
-                return Err(self.error(BvhErrorKind::Expected {
-                    expected,
-                    found: quote(&line),
-                }));
+                let expected = if frames.is_none() { "`Frames: N`" } else { "`Frame Time: SECONDS`" };
+                return Err(self.error(BvhErrorKind::Expected { expected, found: quote(&line) }));
             }
         }
         Ok((frames.unwrap_or(0), frame_time.unwrap_or(0.0)))
     }
 
     /// Streams the motion lines. Returns the values and the frame count.
-    fn read_frames(
-        &mut self,
-        skeleton: &Skeleton,
-        declared: u64,
-    ) -> Result<(Vec<f64>, usize), BvhError> {
+    fn read_frames(&mut self, skeleton: &Skeleton, declared: u64) -> Result<(Vec<f64>, usize), BvhError> {
         let channels = skeleton.channel_count();
         // Trust the declared count only as far as the remaining bytes could
         // hold it (two bytes a value at the least), so a wrong count never
@@ -510,7 +412,13 @@ impl<R: BufRead> Reader<R> {
                 .take(want as u64)
                 .read_to_end(&mut buf)
                 .map_err(|e| self.error(BvhErrorKind::Io(e)))?;
-            eof = got < want;
+            // A block that exactly fills may still be the last one: peek,
+            // so a short final line reads as truncated wherever blocks end.
+            eof = got < want
+                || match self.input.fill_buf() {
+                    Ok(rest) => rest.is_empty(),
+                    Err(e) => return Err(self.error(BvhErrorKind::Io(e))),
+                };
             let complete = if eof {
                 buf.len()
             } else {
@@ -529,16 +437,8 @@ impl<R: BufRead> Reader<R> {
                 Err((p, err)) => {
                     self.line += p.lines + 1;
                     let frame = frames + p.frames + 1;
-                    let rest_is_blank = region[err.line_end..]
-                        .iter()
-                        .all(|b| b.is_ascii_whitespace());
-                    return Err(self.error(frame_error(
-                        skeleton,
-                        frame,
-                        channels,
-                        eof && rest_is_blank,
-                        err.kind,
-                    )));
+                    let rest_is_blank = region[err.line_end..].iter().all(|b| b.is_ascii_whitespace());
+                    return Err(self.error(frame_error(skeleton, frame, channels, eof && rest_is_blank, err.kind)));
                 }
             };
             frames += done_lines.frames;
@@ -613,10 +513,7 @@ fn split_at_lines(region: &[u8], parts: usize) -> Vec<(usize, usize)> {
     let mut start = 0;
     while start < region.len() {
         let nominal = (start + step).min(region.len());
-        let end = region[nominal..]
-            .iter()
-            .position(|&b| b == b'\n')
-            .map_or(region.len(), |p| nominal + p + 1);
+        let end = region[nominal..].iter().position(|&b| b == b'\n').map_or(region.len(), |p| nominal + p + 1);
         cuts.push((start, end));
         start = end;
     }
@@ -636,27 +533,12 @@ fn parse_lines(region: &[u8], channels: usize, data: &mut Vec<f64>) -> Parsed {
             }
             Ok((count, next)) => {
                 data.truncate(before);
-                return Err((
-                    progress,
-                    LineError {
-                        kind: LineProblem::Count(count),
-                        line_end: next,
-                    },
-                ));
+                return Err((progress, LineError { kind: LineProblem::Count(count), line_end: next }));
             }
             Err(token) => {
                 data.truncate(before);
-                let line_end = region[pos..]
-                    .iter()
-                    .position(|&b| b == b'\n')
-                    .map_or(region.len(), |p| pos + p + 1);
-                return Err((
-                    progress,
-                    LineError {
-                        kind: LineProblem::Token(token),
-                        line_end,
-                    },
-                ));
+                let line_end = region[pos..].iter().position(|&b| b == b'\n').map_or(region.len(), |p| pos + p + 1);
+                return Err((progress, LineError { kind: LineProblem::Token(token), line_end }));
             }
         }
         progress.lines += 1;
@@ -666,46 +548,18 @@ fn parse_lines(region: &[u8], channels: usize, data: &mut Vec<f64>) -> Parsed {
 
 /// The error for a bad motion line: which frame, and which joint's channel
 /// when one value is at fault.
-fn frame_error(
-    skeleton: &Skeleton,
-    frame: usize,
-    expected: usize,
-    at_end: bool,
-    problem: LineProblem,
-) -> BvhErrorKind {
+fn frame_error(skeleton: &Skeleton, frame: usize, expected: usize, at_end: bool, problem: LineProblem) -> BvhErrorKind {
     match problem {
-        LineProblem::Count(found) if at_end && found < expected => BvhErrorKind::TruncatedFrame {
-            frame,
-            found,
-            expected,
-        },
-        LineProblem::Count(found) => BvhErrorKind::WrongValueCount {
-            frame,
-            found,
-            expected,
-        },
-        LineProblem::Token(TokenError {
-            index,
-            problem,
-            token,
-        }) => {
+        LineProblem::Count(found) if at_end && found < expected => {
+            BvhErrorKind::TruncatedFrame { frame, found, expected }
+        }
+        LineProblem::Count(found) => BvhErrorKind::WrongValueCount { frame, found, expected },
+        LineProblem::Token(TokenError { index, problem, token }) => {
             let (joint, channel_name) = channel_owner(skeleton, index);
             let channel = index + 1;
             match problem {
-                TokenProblem::NonFinite => BvhErrorKind::NonFinite {
-                    frame,
-                    channel,
-                    joint,
-                    channel_name,
-                    token,
-                },
-                TokenProblem::NonNumeric => BvhErrorKind::NonNumeric {
-                    frame,
-                    channel,
-                    joint,
-                    channel_name,
-                    token,
-                },
+                TokenProblem::NonFinite => BvhErrorKind::NonFinite { frame, channel, joint, channel_name, token },
+                TokenProblem::NonNumeric => BvhErrorKind::NonNumeric { frame, channel, joint, channel_name, token },
             }
         }
     }

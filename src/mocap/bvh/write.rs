@@ -12,16 +12,10 @@ pub fn write_bvh(bvh: &Bvh, out: &mut impl Write) -> io::Result<()> {
     let order = preorder(skeleton);
     let mut text = String::with_capacity(4096);
     text.push_str("HIERARCHY\n");
-    for &root in order
-        .iter()
-        .filter(|&&j| skeleton.joints[j].parent.is_none())
-    {
+    for &root in order.iter().filter(|&&j| skeleton.joints[j].parent.is_none()) {
         write_joint(skeleton, root, 0, &mut text);
     }
-    text.push_str(&format!(
-        "MOTION\nFrames: {}\nFrame Time: {}\n",
-        bvh.frames, bvh.frame_time_s
-    ));
+    text.push_str(&format!("MOTION\nFrames: {}\nFrame Time: {}\n", bvh.frames, bvh.frame_time_s));
     out.write_all(text.as_bytes())?;
 
     // Channel indices in the order the hierarchy above lists them.
@@ -66,22 +60,11 @@ fn preorder(skeleton: &Skeleton) -> Vec<usize> {
 fn write_joint(skeleton: &Skeleton, j: usize, depth: usize, text: &mut String) {
     let joint = &skeleton.joints[j];
     let indent = "\t".repeat(depth);
-    let keyword = if joint.parent.is_none() {
-        "ROOT"
-    } else {
-        "JOINT"
-    };
+    let keyword = if joint.parent.is_none() { "ROOT" } else { "JOINT" };
     text.push_str(&format!("{indent}{keyword} {}\n{indent}{{\n", joint.name));
-    text.push_str(&format!(
-        "{indent}\tOFFSET {}\n",
-        fixed3(joint.offset.to_array())
-    ));
+    text.push_str(&format!("{indent}\tOFFSET {}\n", fixed3(joint.offset.to_array())));
     let names: Vec<&str> = joint.channels.iter().map(|c| c.name()).collect();
-    text.push_str(&format!(
-        "{indent}\tCHANNELS {} {}\n",
-        names.len(),
-        names.join(" ")
-    ));
+    text.push_str(&format!("{indent}\tCHANNELS {} {}\n", names.len(), names.join(" ")));
     for child in skeleton.children(j) {
         write_joint(skeleton, child, depth + 1, text);
     }
@@ -155,22 +138,9 @@ mod tests {
 
     #[test]
     fn fixed6_matches_standard_formatting_and_drops_negative_zero() {
-        for v in [
-            0.0,
-            1.0,
-            -1.5,
-            179.999999,
-            123456.000001,
-            -0.0000004,
-            1e-7,
-            98765.4321,
-        ] {
+        for v in [0.0, 1.0, -1.5, 179.999999, 123456.000001, -0.0000004, 1e-7, 98765.4321] {
             let expected = format!("{v:.6}");
-            let expected = if expected == "-0.000000" {
-                "0.000000".to_string()
-            } else {
-                expected
-            };
+            let expected = if expected == "-0.000000" { "0.000000".to_string() } else { expected };
             assert_eq!(fixed(v), expected, "{v}");
         }
         assert_eq!(fixed(-0.0), "0.000000");

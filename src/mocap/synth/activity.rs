@@ -21,14 +21,8 @@ pub enum Activity {
 }
 
 impl Activity {
-    pub const ALL: [Activity; 6] = [
-        Activity::Circles,
-        Activity::WaveH,
-        Activity::WaveV,
-        Activity::Punch,
-        Activity::Reach,
-        Activity::Twist,
-    ];
+    pub const ALL: [Activity; 6] =
+        [Activity::Circles, Activity::WaveH, Activity::WaveV, Activity::Punch, Activity::Reach, Activity::Twist];
 
     /// The name used on the command line, in file names and in labels.
     pub fn name(self) -> &'static str {
@@ -137,36 +131,29 @@ pub fn drive(activity: Activity, tau: f64, v: &Variation, amplitude: f64, rig: &
             d.shift = DVec3::new(side * 0.01 * c, 0.0, 0.0);
         }
         Activity::WaveH => {
-            let elbow = DVec3::new(side * 0.9, 0.1 * v.shape[0], 0.45 + 0.1 * v.pole).normalize()
-                * rig.upper_arm();
+            let elbow = DVec3::new(side * 0.9, 0.1 * v.shape[0], 0.45 + 0.1 * v.pole).normalize() * rig.upper_arm();
             let swing = 0.10 + 0.42 * a * s;
-            let forearm = DVec3::new(side * swing.sin(), swing.cos(), 0.2).normalize()
-                * (l - rig.upper_arm());
+            let forearm = DVec3::new(side * swing.sin(), swing.cos(), 0.2).normalize() * (l - rig.upper_arm());
             place_elbow(&mut d, k, elbow, forearm, v.offset * 0.5 * l);
             d.wrists[k] = DVec3::new(0.0, 0.3 * a * (theta - 0.5).sin(), 0.0);
-            d.torso = DVec3::new(0.0, 0.02 * s, -side * 0.03 + 0.015 * s);
+            d.torso = DVec3::new(0.01 * s, 0.05 * s, -side * 0.03 + 0.03 * s);
             d.head = DVec3::new(0.0, side * 0.1, 0.03 * (theta - 0.4).sin());
         }
         Activity::WaveV => {
-            let elbow = DVec3::new(side * 0.3, -0.55 + 0.1 * v.shape[0], 0.75).normalize()
-                * rig.upper_arm();
+            let elbow = DVec3::new(side * 0.3, -0.55 + 0.1 * v.shape[0], 0.75).normalize() * rig.upper_arm();
             let lift = 0.5 + 0.45 * a * s;
-            let forearm =
-                DVec3::new(side * 0.05, lift.sin(), lift.cos()).normalize() * (l - rig.upper_arm());
+            let forearm = DVec3::new(side * 0.05, lift.sin(), lift.cos()).normalize() * (l - rig.upper_arm());
             place_elbow(&mut d, k, elbow, forearm, v.offset * 0.5 * l);
             d.wrists[k] = DVec3::new(0.0, 0.0, 0.35 * a * (theta - 0.6).sin());
-            d.torso = DVec3::new(0.02 + 0.015 * s, 0.0, 0.0);
+            d.torso = DVec3::new(0.02 + 0.05 * s, side * 0.04 * s, 0.03 * s);
             d.head = DVec3::new(-0.04 * s, side * 0.05, 0.0);
             d.crouch += 0.002 * s;
         }
         Activity::Punch => {
             let guard = |side: f64| DVec3::new(-side * 0.22, 0.12, 0.40) * l;
             let guard_pole = |side: f64| DVec3::new(side * 0.4, -1.0, -0.2);
-            let target = DVec3::new(
-                side * (-0.10 + 0.05 * v.shape[0]),
-                0.03 + 0.06 * v.shape[1],
-                1.05 * (0.9 + 0.1 * a),
-            ) * l;
+            let target =
+                DVec3::new(side * (-0.10 + 0.05 * v.shape[0]), 0.03 + 0.06 * v.shape[1], 1.05 * (0.9 + 0.1 * a)) * l;
             let out = pulse(tau, [0.30, 0.46, 0.54, 0.94]);
             d.hands[k] = guard(side).lerp(target, out) + v.offset * l;
             d.poles[k] = guard_pole(side).lerp(DVec3::new(side * 0.3, -1.0, 0.0), out);
@@ -174,36 +161,34 @@ pub fn drive(activity: Activity, tau: f64, v: &Variation, amplitude: f64, rig: &
             d.hands[o] = guard(other) + DVec3::new(0.0, 0.01 * l * s, 0.0);
             d.poles[o] = guard_pole(other);
             d.torso = DVec3::new(0.04 + 0.05 * out, -side * 0.22 * a * out, 0.0);
+            // The fist turns over (pronates) as it lands, and cocks back in guard.
+            d.wrists[k] = DVec3::new(side * 0.8 * out, 0.0, 0.15 * (1.0 - out));
             d.hip_turn = -side * 0.08 * out;
             d.head = DVec3::new(0.0, side * 0.15 * out, 0.0);
             d.crouch = 0.02;
             d.shift = DVec3::new(0.0, 0.0, 0.02 * out);
         }
         Activity::Reach => {
-            let dir = DVec3::new(
-                side * (0.25 + 0.25 * v.shape[0]),
-                0.05 + 0.35 * v.shape[1],
-                0.9,
-            )
-            .normalize();
-            let target = dir * rig.reach_at(30f64.to_radians()) * a.min(1.0);
+            let dir = DVec3::new(side * (0.25 + 0.25 * v.shape[0]), 0.05 + 0.35 * v.shape[1], 0.9).normalize();
+            // Beyond reach is fine: the arm's inverse kinematics eases it in.
+            let target = dir * rig.reach_at(30f64.to_radians()) * a;
             let out = pulse(tau, [0.08, 0.42, 0.58, 0.92]);
             d.hands[k] = d.hands[k].lerp(target + v.offset * l, out);
             d.poles[k] = d.poles[k].lerp(DVec3::new(side * 0.5, -1.0, -0.2), out);
+            // The hand turns palm-in and lifts toward what it reaches for.
+            d.wrists[k] = DVec3::new(-side * 0.5 * out, 0.0, -0.25 * out);
             d.torso = DVec3::new(0.10 * out * dir.z, side * 0.06 * out, -side * 0.03 * out);
-            d.head = DVec3::new(-0.3 * dir.y * out, side * 0.15 * out * dir.x.abs(), 0.0);
+            d.head = DVec3::new(-0.3 * dir.y * out, side * 0.15 * out, 0.0);
             d.crouch += 0.01 * out;
             d.shift = DVec3::new(side * 0.01 * out, 0.0, 0.02 * out);
         }
         Activity::Twist => {
             for (k, side) in [LEFT, RIGHT] {
-                d.hands[k] = DVec3::new(
-                    side * 0.12,
-                    -0.45 + 0.05 * (2.0 * theta).sin(),
-                    0.45 + side * 0.10 * a * s,
-                ) * l
+                d.hands[k] = DVec3::new(side * 0.12, -0.45 + 0.05 * (2.0 * theta).sin(), 0.45 + side * 0.10 * a * s)
+                    * l
                     + v.offset * l;
                 d.poles[k] = DVec3::new(side * 0.5, -0.6, -0.6);
+                d.wrists[k] = DVec3::new(0.0, 0.0, 0.2 * a * (theta + side).sin());
             }
             d.hip_turn = 0.32 * a * s;
             d.torso = DVec3::new(0.06, -0.45 * a * s, 0.03 * (2.0 * theta).sin());

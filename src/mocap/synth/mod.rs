@@ -25,8 +25,9 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
 /// Seconds of standing at rest before the first and after the last activity.
-const REST_S: f64 = 0.6;
-/// Longest crossfade between two parts of a take, seconds.
+const REST_S: f64 = 1.0;
+/// Crossfade between two parts of a take at 1× speed, seconds; slower or
+/// faster takes change activity at their own pace (within 0.3–1.2 s).
 const TRANSITION_S: f64 = 0.5;
 /// Draws beyond this many standard deviations are clipped.
 const CLIP_SIGMA: f64 = 2.5;
@@ -82,10 +83,7 @@ pub const REST_LABEL: &str = "rest";
 /// One activity, repeated, between rests. Each activity draws from its own
 /// random stream, so a take does not depend on which others are made.
 pub fn activity_take(activity: Activity, options: &SynthOptions) -> Take {
-    let stream = Activity::ALL
-        .iter()
-        .position(|&a| a == activity)
-        .expect("listed") as u64;
+    let stream = Activity::ALL.iter().position(|&a| a == activity).expect("listed") as u64;
     compose(&[activity], options, stream)
 }
 
@@ -181,11 +179,7 @@ impl Clock {
 /// What a stretch of a take performs.
 enum Part {
     Rest,
-    Active {
-        clock: Clock,
-        phases: Vec<f64>,
-        first: i64,
-    },
+    Active { clock: Clock, phases: Vec<f64>, first: i64 },
 }
 
 fn compose(activities: &[Activity], options: &SynthOptions, stream: u64) -> Take {
@@ -206,41 +200,26 @@ fn compose(activities: &[Activity], options: &SynthOptions, stream: u64) -> Take
     }
     let total = bounds.last().expect("never empty") + rest_frames;
     bounds.push(total);
-    // Crossfades are centred on each inner boundary, no wider than a
-    // third of the parts they join.
+    // Crossfades are centred on each inner boundary and cover at most half
+    // of the parts they join, so two never overlap.
     let shortest = bounds.windows(2).map(|w| w[1] - w[0]).min().unwrap_or(1);
-    let half_fade = ((TRANSITION_S / dt / 2.0).round() as i64)
-        .min(shortest / 3)
-        .max(1);
+    let fade_s = (TRANSITION_S / options.speed).clamp(0.3, 1.2);
+    let half_fade = ((fade_s / dt / 2.0).round() as i64).min(shortest / 2 - 1).max(1);
 
     let mut parts = vec![Part::Rest];
     for (k, clock) in clocks.into_iter().enumerate() {
         let (start, end) = (bounds[k + 1], bounds[k + 2]);
         let first = -half_fade;
         let phases = clock.phases(first, end - start + half_fade, dt, options.speed);
-        parts.push(Part::Active {
-            clock,
-            phases,
-            first,
-        });
+        parts.push(Part::Active { clock, phases, first });
     }
     parts.push(Part::Rest);
 
     let drive_of = |part: &Part, frame: i64, start: i64| match part {
         Part::Rest => activity::rest(&rig),
-        Part::Active {
-            clock,
-            phases,
-            first,
-        } => {
+        Part::Active { clock, phases, first } => {
             let phase = phases[(frame - start - first) as usize];
-            activity::drive(
-                clock.activity,
-                phase.rem_euclid(1.0),
-                &clock.variation(phase),
-                options.amplitude,
-                &rig,
-            )
+            activity::drive(clock.activity, phase.rem_euclid(1.0), &clock.variation(phase), options.amplitude, &rig)
         }
     };
 
@@ -248,14 +227,9 @@ fn compose(activities: &[Activity], options: &SynthOptions, stream: u64) -> Take
     let mut labels = Vec::with_capacity(total as usize);
     for frame in 0..total {
         // The part this frame belongs to, and the boundary nearest it.
-        let p = bounds
-            .windows(2)
-            .position(|w| frame < w[1])
-            .unwrap_or(parts.len() - 1);
+        let p = bounds.windows(2).position(|w| frame < w[1]).unwrap_or(parts.len() - 1);
         let mut drive = drive_of(&parts[p], frame, bounds[p]);
-        let fade = |boundary: i64| {
-            smoothstep5((frame - (boundary - half_fade)) as f64 / (2 * half_fade) as f64)
-        };
+        let fade = |boundary: i64| smoothstep5((frame - (boundary - half_fade)) as f64 / (2 * half_fade) as f64);
         if p + 1 < parts.len() && frame >= bounds[p + 1] - half_fade {
             let next = drive_of(&parts[p + 1], frame, bounds[p + 1]);
             drive = drive.lerp(&next, fade(bounds[p + 1]));
@@ -282,12 +256,5 @@ fn compose(activities: &[Activity], options: &SynthOptions, stream: u64) -> Take
             }
         }
     }
-    Take {
-        motion: Motion {
-            body: rig.body,
-            frame_time_s: dt,
-            poses,
-        },
-        labels,
-    }
+    Take { motion: Motion { body: rig.body, frame_time_s: dt, poses }, labels }
 }

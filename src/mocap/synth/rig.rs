@@ -32,23 +32,18 @@ pub struct Drive {
 }
 
 impl Drive {
-    /// Componentwise blend: `self` at `t = 0`, `other` at `t = 1`.
+    /// Blend: `self` at `t = 0`, `other` at `t = 1`. Hands swing about the
+    /// shoulder (direction and distance blend separately), as a straight
+    /// line between two targets can pass through the shoulder and fold the
+    /// elbow shut; everything else blends linearly.
     pub fn lerp(&self, other: &Drive, t: f64) -> Drive {
         let v = |a: DVec3, b: DVec3| a.lerp(b, t);
         let f = |a: f64, b: f64| a + (b - a) * t;
+        let swing = |a: DVec3, b: DVec3| slerp(a.normalize(), b.normalize(), t) * f(a.length(), b.length());
         Drive {
-            hands: [
-                v(self.hands[0], other.hands[0]),
-                v(self.hands[1], other.hands[1]),
-            ],
-            poles: [
-                v(self.poles[0], other.poles[0]),
-                v(self.poles[1], other.poles[1]),
-            ],
-            wrists: [
-                v(self.wrists[0], other.wrists[0]),
-                v(self.wrists[1], other.wrists[1]),
-            ],
+            hands: [swing(self.hands[0], other.hands[0]), swing(self.hands[1], other.hands[1])],
+            poles: [v(self.poles[0], other.poles[0]), v(self.poles[1], other.poles[1])],
+            wrists: [v(self.wrists[0], other.wrists[0]), v(self.wrists[1], other.wrists[1])],
             torso: v(self.torso, other.torso),
             hip_turn: f(self.hip_turn, other.hip_turn),
             head: v(self.head, other.head),
@@ -56,6 +51,15 @@ impl Drive {
             shift: v(self.shift, other.shift),
         }
     }
+}
+
+/// Spherical interpolation between unit vectors that are never opposite.
+fn slerp(a: DVec3, b: DVec3, t: f64) -> DVec3 {
+    let angle = a.angle_between(b);
+    if angle < 1e-9 {
+        return a.lerp(b, t).normalize();
+    }
+    (a * ((1.0 - t) * angle).sin() + b * (t * angle).sin()) / angle.sin()
 }
 
 /// Shares of the torso rotation taken by pelvis, spine and chest.
@@ -79,12 +83,7 @@ impl Chain {
     /// Hinge flexion never exceeds 140°, inside the 150° joint limit.
     fn new(a: f64, b: f64, margin_share: f64) -> Chain {
         let min_reach = (a * a + b * b + 2.0 * a * b * 140f64.to_radians().cos()).sqrt();
-        Chain {
-            a,
-            b,
-            min_reach,
-            margin: margin_share * (a + b),
-        }
+        Chain { a, b, min_reach, margin: margin_share * (a + b) }
     }
 
     /// The rotation of the first link (rest direction `rest_bone`, hinge
@@ -92,19 +91,11 @@ impl Chain {
     /// to `target`, bending toward `pole`. Targets beyond reach, or too
     /// close, are eased smoothly inside it, so a smooth target path gives a
     /// smooth pose.
-    fn solve(
-        &self,
-        target: DVec3,
-        pole: DVec3,
-        rest_bone: DVec3,
-        rest_axis: DVec3,
-    ) -> (DQuat, f64) {
+    fn solve(&self, target: DVec3, pole: DVec3, rest_bone: DVec3, rest_axis: DVec3) -> (DQuat, f64) {
         let (a, b) = (self.a, self.b);
         let axis = target.normalize();
         let d = soft_clamp(target.length(), self.min_reach, a + b, self.margin);
-        let flexion = ((d * d - a * a - b * b) / (2.0 * a * b))
-            .clamp(-1.0, 1.0)
-            .acos();
+        let flexion = ((d * d - a * a - b * b) / (2.0 * a * b)).clamp(-1.0, 1.0).acos();
         let cos_root = ((a * a + d * d - b * b) / (2.0 * a * d)).clamp(-1.0, 1.0);
         let across = (pole - axis * pole.dot(axis)).normalize();
         let first = axis * cos_root + across * (1.0 - cos_root * cos_root).sqrt();
@@ -177,17 +168,10 @@ impl Rig {
         local[Head.index()] = exp_map(drive.head * (2.0 / 3.0));
 
         for (k, side) in SIDES {
-            let [shoulder, elbow, wrist] = if side > 0.0 {
-                [LeftShoulder, LeftElbow, LeftWrist]
-            } else {
-                [RightShoulder, RightElbow, RightWrist]
-            };
-            let (rotation, flexion) = self.arm.solve(
-                drive.hands[k],
-                drive.poles[k],
-                body.bone(shoulder),
-                hinge_axis(elbow),
-            );
+            let [shoulder, elbow, wrist] =
+                if side > 0.0 { [LeftShoulder, LeftElbow, LeftWrist] } else { [RightShoulder, RightElbow, RightWrist] };
+            let (rotation, flexion) =
+                self.arm.solve(drive.hands[k], drive.poles[k], body.bone(shoulder), hinge_axis(elbow));
             local[shoulder.index()] = rotation;
             local[elbow.index()] = DQuat::from_axis_angle(hinge_axis(elbow), flexion);
             local[wrist.index()] = exp_map(drive.wrists[k]);
@@ -196,18 +180,13 @@ impl Rig {
         let pelvis_rotation = local[Pelvis.index()];
         let root = DVec3::new(0.0, body.pelvis_height() - drive.crouch, 0.0) + drive.shift;
         for (_, side) in SIDES {
-            let [hip, knee, ankle] = if side > 0.0 {
-                [LeftHip, LeftKnee, LeftAnkle]
-            } else {
-                [RightHip, RightKnee, RightAnkle]
-            };
+            let [hip, knee, ankle] =
+                if side > 0.0 { [LeftHip, LeftKnee, LeftAnkle] } else { [RightHip, RightKnee, RightAnkle] };
             let hip_at = root + pelvis_rotation * body.offset(hip);
             // Feet stay flat where they stand in the rest pose.
             let rest_hip = DVec3::new(0.0, body.pelvis_height(), 0.0) + body.offset(hip);
             let foot_at = rest_hip - DVec3::Y * (self.leg.a + self.leg.b);
-            let (thigh, flexion) =
-                self.leg
-                    .solve(foot_at - hip_at, DVec3::Z, body.bone(hip), hinge_axis(knee));
+            let (thigh, flexion) = self.leg.solve(foot_at - hip_at, DVec3::Z, body.bone(hip), hinge_axis(knee));
             local[hip.index()] = pelvis_rotation.inverse() * thigh;
             local[knee.index()] = DQuat::from_axis_angle(hinge_axis(knee), flexion);
             local[ankle.index()] = (thigh * local[knee.index()]).inverse();
@@ -230,10 +209,7 @@ mod tests {
     fn neutral(rig: &Rig) -> Drive {
         let hang = rig.reach_at(0.3);
         Drive {
-            hands: [
-                DVec3::new(0.05, -hang, 0.05),
-                DVec3::new(-0.05, -hang, 0.05),
-            ],
+            hands: [DVec3::new(0.05, -hang, 0.05), DVec3::new(-0.05, -hang, 0.05)],
             poles: [DVec3::new(0.2, 0.0, -1.0), DVec3::new(-0.2, 0.0, -1.0)],
             wrists: [DVec3::ZERO; 2],
             torso: DVec3::ZERO,
@@ -253,15 +229,10 @@ mod tests {
         let pose = rig.pose(&drive);
         let frame = rig.body.forward(&pose);
         let chest = frame.rotation(Joint::Chest);
-        let wrist = chest.inverse()
-            * (frame.position(Joint::RightWrist) - frame.position(Joint::RightShoulder));
+        let wrist = chest.inverse() * (frame.position(Joint::RightWrist) - frame.position(Joint::RightShoulder));
         assert!((wrist - drive.hands[1]).length() < 1e-9, "{wrist:?}");
-        let elbow = chest.inverse()
-            * (frame.position(Joint::RightElbow) - frame.position(Joint::RightShoulder));
-        assert!(
-            elbow.y < 0.0 && elbow.x < 0.0,
-            "elbow down and out: {elbow:?}"
-        );
+        let elbow = chest.inverse() * (frame.position(Joint::RightElbow) - frame.position(Joint::RightShoulder));
+        assert!(elbow.y < 0.0 && elbow.x < 0.0, "elbow down and out: {elbow:?}");
         let flexion = pose.joint(Joint::RightElbow)[0];
         assert!(flexion > 0.5 && flexion < 150f64.to_radians());
     }
