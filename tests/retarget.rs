@@ -375,3 +375,52 @@ fn retargeting_is_deterministic_to_the_bit() {
     };
     assert_eq!(write(), write());
 }
+
+#[test]
+fn a_canonical_take_exported_z_up_with_positions_on_every_joint_reads_back_exactly() {
+    // What Blender's BVH export writes: the rest pose turned to stand along
+    // +Z, and six channels on every joint whose positions repeat the OFFSET.
+    use imitate::mocap::bvh::{Bvh, Channel};
+    use imitate::mocap::math::{Axis, EulerOrder};
+    let motion = activity_take(Activity::Reach, &SynthOptions { repetitions: 1, ..Default::default() }).motion;
+    let to_z_up = glam::DQuat::from_rotation_arc(DVec3::Y, DVec3::Z);
+    let order = EulerOrder::ZXY;
+    let mut skeleton = Motion::skeleton(&motion.body);
+    for (k, joint) in skeleton.joints.iter_mut().enumerate() {
+        joint.offset = to_z_up * joint.offset;
+        joint.end_site = joint.end_site.map(|e| to_z_up * e);
+        joint.channels = Axis::ALL.map(Channel::Position).into_iter().chain(order.0.map(Channel::Rotation)).collect();
+        joint.first_channel = 6 * k;
+    }
+    let mut data = Vec::new();
+    for pose in &motion.poses {
+        for (k, j) in Joint::ALL.into_iter().enumerate() {
+            let position = if k == 0 { to_z_up * pose.root } else { skeleton.joints[k].offset };
+            data.extend(position.to_array());
+            let rotation = to_z_up * pose.local_rotation(j) * to_z_up.inverse();
+            data.extend(order.from_quat(rotation).map(f64::to_degrees));
+        }
+    }
+    let frames = motion.poses.len();
+    let blender_style = Bvh {
+        skeleton,
+        frame_time_s: motion.frame_time_s,
+        data,
+        frames,
+        declared_frames: frames as u64,
+        warnings: vec![],
+    };
+    let mut text = Vec::new();
+    write_bvh(&blender_style, &mut text).unwrap();
+    let bvh = read_bvh_bytes(&text, "from_blender.bvh").unwrap();
+    let (r, back) = retarget(&bvh);
+    assert_eq!(r.analysis().up_axis, "+Z");
+    assert!(r.analysis().warnings.iter().any(|w| w.code == "absolute_position_channels"));
+    for (a, b) in motion.poses.iter().zip(&back.poses) {
+        assert!((a.root - b.root).length() < 1e-6);
+        for j in Joint::ALL {
+            let d = log_map(a.local_rotation(j).inverse() * b.local_rotation(j)).length();
+            assert!(d < 1e-6, "{j:?} differs by {d:e} rad");
+        }
+    }
+}

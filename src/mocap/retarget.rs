@@ -295,16 +295,17 @@ impl Retargeter {
     }
 
     fn direct_pose(&self, frame: &[f64], direct: &[usize; JOINTS]) -> Pose {
+        // The file's rest frames are the canonical ones turned by the
+        // inverse of `up`, so every rotation carries over conjugated.
         let mut local = [DQuat::IDENTITY; JOINTS];
         let mut root = DVec3::ZERO;
+        let down = self.up.inverse();
         for j in Joint::ALL {
             let (t, r) = self.kin.local(direct[j.index()], frame);
             if j == Joint::Pelvis {
                 root = self.up * t * self.scale;
-                local[j.index()] = self.up * r;
-            } else {
-                local[j.index()] = r;
             }
+            local[j.index()] = self.up * r * down;
         }
         Pose::from_rotations(root, &local)
     }
@@ -455,16 +456,18 @@ impl Retargeter {
             );
             a.warnings.push(Warning { code: "landmarks_unmapped", message });
         }
-        for (name, mode) in &a.position_channels {
-            if *mode == PositionMode::Absolute {
-                let message = format!(
-                    "joint `{name}` has position channels that hold its whole local position (they equal its OFFSET); read as absolute"
-                );
-                a.warnings.push(Warning { code: "absolute_position_channels", message });
-            }
+        let absolute: Vec<&str> =
+            a.position_channels.iter().filter(|(_, m)| *m == PositionMode::Absolute).map(|(n, _)| n.as_str()).collect();
+        if !absolute.is_empty() {
+            let message = format!(
+                "position channels below the root hold whole local positions (equal to the OFFSET, as Blender \
+                 writes them) on {}; read as absolute",
+                absolute.join(", ")
+            );
+            a.warnings.push(Warning { code: "absolute_position_channels", message });
         }
         if mapping.scheme == "canonical" {
-            self.direct = canonical_joints(bvh, &self.body);
+            self.direct = canonical_joints(bvh, &self.body, self.up);
             if let Some(direct) = self.direct {
                 // Canonical files carry the rotations themselves; only the root scales.
                 let file_height = [Joint::LeftKnee, Joint::LeftAnkle]
@@ -761,9 +764,10 @@ fn detect_units(height: f64) -> (&'static str, f64) {
     ("unknown", Body::STANDARD_HEIGHT_M / height)
 }
 
-/// For a skeleton that is the canonical one (same names, hierarchy and rest
-/// directions), canonical joint → source joint.
-fn canonical_joints(bvh: &Bvh, body: &Body) -> Option<[usize; JOINTS]> {
+/// For a skeleton that is the canonical one (same names and hierarchy, rest
+/// directions the same once turned upright by `up`), canonical joint →
+/// source joint.
+fn canonical_joints(bvh: &Bvh, body: &Body, up: DQuat) -> Option<[usize; JOINTS]> {
     let skeleton = &bvh.skeleton;
     let mut map = [0usize; JOINTS];
     for j in Joint::ALL {
@@ -773,7 +777,7 @@ fn canonical_joints(bvh: &Bvh, body: &Body) -> Option<[usize; JOINTS]> {
         if joint.parent != j.parent().map(|p| map[p.index()]) {
             return None;
         }
-        if j != Joint::Pelvis && joint.offset.normalize_or_zero().dot(body.offset(j).normalize()) < 0.9995 {
+        if j != Joint::Pelvis && (up * joint.offset).normalize_or_zero().dot(body.offset(j).normalize()) < 0.9995 {
             return None;
         }
         let rotations = joint.channels.iter().filter(|c| matches!(c, crate::mocap::bvh::Channel::Rotation(_))).count();
