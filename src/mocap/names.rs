@@ -391,7 +391,8 @@ pub fn map_skeleton(skeleton: &Skeleton, user: Option<&UserMapping>) -> Result<M
             }
             mapping.points.insert(*landmark, SourcePoint { joint: index, end_site: *end_site });
         }
-        if user.entries.len() >= Landmark::all().count() || mapping.points.len() == user.entries.len() {
+        // Every mapped point came from the user's file.
+        if mapping.points.len() == user.entries.len() {
             mapping.scheme = "user";
         }
     }

@@ -123,6 +123,15 @@ impl SourceFrame {
     fn sj(&self, j: Joint) -> Option<DQuat> {
         self.s[j.index()]
     }
+
+    /// The frame turned by `up`, keeping only the landmarks still mapped.
+    fn turned(&self, up: DQuat, points: &[Option<SourcePoint>; LANDMARKS]) -> SourceFrame {
+        let keep = |k: usize| points[k].is_some();
+        SourceFrame {
+            p: std::array::from_fn(|k| self.p[k].filter(|_| keep(k)).map(|v| up * v)),
+            s: std::array::from_fn(|k| self.s[k].filter(|_| keep(k)).map(|q| up * q)),
+        }
+    }
 }
 
 /// The arms and legs: a ball joint, a hinge, and the joint at the far end.
@@ -178,7 +187,7 @@ pub struct Retargeter {
     cal: Calibration,
     body: Body,
     /// Canonical joint → source joint, when the source is a canonical
-    /// skeleton whose rotations carry over unchanged.
+    /// skeleton whose rotations carry over exactly.
     direct: Option<[usize; JOINTS]>,
     analysis: Analysis,
 }
@@ -231,8 +240,16 @@ impl Retargeter {
                 warnings: Vec::new(),
             },
         };
-        r.analyse(bvh, &mapping, options)?;
-        r.calibrate(bvh);
+        // Up to SAMPLE_FRAMES frames, in the file's own axes, serve the
+        // analysis and (turned upright) the calibration.
+        let mut scratch = vec![Transform::default(); skeleton.joints.len()];
+        let frames: Vec<SourceFrame> =
+            sample_frames(bvh.frames).into_iter().map(|f| r.source_frame(bvh.frame(f), &mut scratch)).collect();
+        r.analyse(bvh, &mapping, options, &frames)?;
+        if r.direct.is_none() {
+            let upright: Vec<SourceFrame> = frames.iter().map(|f| f.turned(r.up, &r.points)).collect();
+            r.cal = r.calibrate(&upright);
+        }
         Ok(r)
     }
 
@@ -375,13 +392,17 @@ impl Retargeter {
         Solved { rotations: w, hinge_angles }
     }
 
-    fn analyse(&mut self, bvh: &Bvh, mapping: &Mapping, options: &RetargetOptions) -> Result<(), RetargetError> {
+    /// Mapping report, implausible tips, up axis, height and units, from
+    /// sampled `frames` in the file's own axes.
+    fn analyse(
+        &mut self,
+        bvh: &Bvh,
+        mapping: &Mapping,
+        options: &RetargetOptions,
+        frames: &[SourceFrame],
+    ) -> Result<(), RetargetError> {
         let skeleton = &bvh.skeleton;
-        // Sampled frames in the file's own axes: tips, up axis, proportions.
-        let samples = sample_frames(bvh.frames);
-        let mut scratch = vec![Transform::default(); skeleton.joints.len()];
-        let frames: Vec<SourceFrame> = samples.iter().map(|&s| self.source_frame(bvh.frame(s), &mut scratch)).collect();
-        for (tip, deviation) in implausible_tips(&frames, &self.body) {
+        for (tip, deviation) in implausible_tips(frames, &self.body) {
             let source = mapping.get(tip).map(|p| p.describe(skeleton)).unwrap_or_default();
             self.points[tip.slot()] = None;
             let message = format!(
@@ -410,10 +431,10 @@ impl Retargeter {
         let (up_vec, up_name) = match options.up {
             Some(UpAxis::Y) => (DVec3::Y, "+Y".to_string()),
             Some(UpAxis::Z) => (DVec3::Z, "+Z".to_string()),
-            None => detect_up(&frames),
+            None => detect_up(frames),
         };
         self.up = DQuat::from_rotation_arc(up_vec, DVec3::Y);
-        let height = estimate_height(&frames, &self.body).ok_or(RetargetError::Degenerate)?;
+        let height = estimate_height(frames, &self.body).ok_or(RetargetError::Degenerate)?;
         self.scale = self.body.proportions.height_m / height;
         let a = &mut self.analysis;
         a.up_axis = up_name;
@@ -480,16 +501,9 @@ impl Retargeter {
         Ok(())
     }
 
-    /// Finds the source-frame directions that stand in for missing
-    /// landmarks and for the bend plane of straight limbs.
-    fn calibrate(&mut self, bvh: &Bvh) {
-        if self.direct.is_some() {
-            return;
-        }
-        let samples = sample_frames(bvh.frames);
-        let mut scratch = vec![Transform::default(); bvh.skeleton.joints.len()];
-        let frames: Vec<SourceFrame> = samples.iter().map(|&s| self.source_frame(bvh.frame(s), &mut scratch)).collect();
-
+    /// The source-frame directions that stand in for missing landmarks and
+    /// for the bend plane of straight limbs, from upright sampled frames.
+    fn calibrate(&self, frames: &[SourceFrame]) -> Calibration {
         // Hinge axes: the line the bend-plane normals (seen from the limb
         // root's frame, weighted by how clearly the limb is bent) cluster
         // on. A plain mean would cancel between frames that flex and frames
@@ -512,7 +526,7 @@ impl Retargeter {
         // over the take, near its rest pose relative to its parent).
         let mut bone_sum = [DVec3::ZERO; 5];
         let mut twist_sum = [DVec3::ZERO; 5];
-        for f in &frames {
+        for f in frames {
             let solved = self.solve(f, &cal);
             let ends = [
                 (Joint::LeftWrist, Joint::LeftElbow, DVec3::Z),
@@ -534,7 +548,7 @@ impl Retargeter {
             cal.end_bone[e] = bone_sum[e].try_normalize();
             cal.end_twist[e] = twist_sum[e].try_normalize();
         }
-        self.cal = cal;
+        cal
     }
 }
 
