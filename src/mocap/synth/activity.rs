@@ -155,14 +155,19 @@ pub fn drive(activity: Activity, tau: f64, v: &Variation, amplitude: f64, rig: &
             let target =
                 DVec3::new(side * (-0.10 + 0.05 * v.shape[0]), 0.03 + 0.06 * v.shape[1], 1.05 * (0.9 + 0.1 * a)) * l;
             let out = pulse(tau, [0.30, 0.46, 0.54, 0.94]);
-            d.hands[k] = guard(side).lerp(target, out) + v.offset * l;
-            d.poles[k] = guard_pole(side).lerp(DVec3::new(side * 0.3, -1.0, 0.0), out);
+            // The fist drives out straight but comes back low and wide, the
+            // elbow dropping, the forearm turning back and the shoulder
+            // leading: a loop, as in captured boxing, not a retrace.
+            let back = if tau > 0.54 { 4.0 * out * (1.0 - out) } else { 0.0 };
+            d.hands[k] = guard(side).lerp(target, out) + DVec3::new(side * 0.12, -0.18, 0.0) * l * back + v.offset * l;
+            d.poles[k] = guard_pole(side).lerp(DVec3::new(side * 0.3, -1.0, 0.0), out)
+                + DVec3::new(side * 0.6, -0.6, 0.0) * back;
             let (o, other) = LEFT;
             d.hands[o] = guard(other) + DVec3::new(0.0, 0.01 * l * s, 0.0);
             d.poles[o] = guard_pole(other);
-            d.torso = DVec3::new(0.04 + 0.05 * out, -side * 0.22 * a * out, 0.0);
+            d.torso = DVec3::new(0.04 + 0.05 * out, -side * (0.22 * a * out - 0.10 * back), 0.0);
             // The fist turns over (pronates) as it lands, and cocks back in guard.
-            d.wrists[k] = DVec3::new(side * 0.8 * out, 0.0, 0.15 * (1.0 - out));
+            d.wrists[k] = DVec3::new(side * (0.8 * out - 0.6 * back), 0.0, 0.15 * (1.0 - out));
             d.hip_turn = -side * 0.08 * out;
             d.head = DVec3::new(0.0, side * 0.15 * out, 0.0);
             d.crouch = 0.02;
