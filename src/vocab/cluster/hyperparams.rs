@@ -1,0 +1,92 @@
+//! Clustering settings, checked once.
+
+/// Clustering settings; [`ClusterParams::check`] validates them.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ClusterParams {
+    /// The number of primitives; chosen from the data when `None`.
+    pub(crate) k: Option<usize>,
+    /// The largest number tried when choosing.
+    pub(crate) max_k: usize,
+    /// k-means restarts; the one with the least inertia wins.
+    pub(crate) runs: usize,
+    pub(crate) seed: u64,
+}
+
+impl Default for ClusterParams {
+    fn default() -> Self {
+        ClusterParams { k: None, max_k: 24, runs: 10, seed: 1 }
+    }
+}
+
+/// Settings that passed [`ClusterParams::check`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ValidClusterParams(pub(crate) ClusterParams);
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ClusterParamsError {
+    #[error("--k must be at least 1")]
+    K,
+    #[error("the largest number of primitives to try must be at least 2, not {0}")]
+    MaxK(usize),
+    #[error("k-means needs at least one run")]
+    Runs,
+}
+
+impl ClusterParams {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    pub fn k(mut self, k: Option<usize>) -> Self {
+        self.k = k;
+        self
+    }
+
+    pub fn max_k(mut self, max_k: usize) -> Self {
+        self.max_k = max_k;
+        self
+    }
+
+    pub fn runs(mut self, runs: usize) -> Self {
+        self.runs = runs;
+        self
+    }
+
+    pub fn seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
+    }
+
+    /// Validates the settings; every rule has its own error.
+    pub fn check(&self) -> Result<ValidClusterParams, ClusterParamsError> {
+        if self.k == Some(0) {
+            return Err(ClusterParamsError::K);
+        }
+        if self.max_k < 2 {
+            return Err(ClusterParamsError::MaxK(self.max_k));
+        }
+        if self.runs == 0 {
+            return Err(ClusterParamsError::Runs);
+        }
+        Ok(ValidClusterParams(self.clone()))
+    }
+}
+
+impl ValidClusterParams {
+    pub fn params(&self) -> &ClusterParams {
+        &self.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_rule_has_its_own_error() {
+        assert!(ClusterParams::new().check().is_ok());
+        assert_eq!(ClusterParams::new().k(Some(0)).check(), Err(ClusterParamsError::K));
+        assert_eq!(ClusterParams::new().max_k(1).check(), Err(ClusterParamsError::MaxK(1)));
+        assert_eq!(ClusterParams::new().runs(0).check(), Err(ClusterParamsError::Runs));
+    }
+}

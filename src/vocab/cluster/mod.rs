@@ -1,0 +1,9 @@
+//! Grouping embedded segments into primitives (GUIDE §3.3): k-means from
+//! linfa-clustering, with the number of primitives chosen by the mean
+//! silhouette unless it is given.
+
+mod algorithm;
+mod hyperparams;
+
+pub use algorithm::{Choice, ClusterError, Clustering};
+pub use hyperparams::{ClusterParams, ClusterParamsError, ValidClusterParams};

@@ -1,0 +1,20 @@
+//! Learning the vocabulary (GUIDE §3): segment takes, embed the segments by
+//! spatio-temporal Isomap, cluster them into primitives, fit each
+//! primitive's latent space and gradient field, and keep the result in one
+//! versioned file.
+
+pub mod cluster;
+pub mod container;
+pub mod corpus;
+pub mod eigen;
+pub mod embed;
+pub mod evaluate;
+pub mod knn;
+pub mod metrics;
+pub mod pca;
+pub mod phase;
+pub mod pipeline;
+pub mod primitive;
+pub mod segment;
+pub mod table;
+pub mod vocabulary;

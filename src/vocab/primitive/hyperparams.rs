@@ -1,0 +1,100 @@
+//! Primitive fitting settings, checked once.
+
+use crate::vocab::knn::MAX_LATENT_DIMS;
+
+/// Fitting settings; [`FitParams::check`] validates them.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FitParams {
+    /// Share of the poses' variance the latent space keeps.
+    pub(crate) variance: f64,
+    pub(crate) min_dims: usize,
+    pub(crate) max_dims: usize,
+    /// Training poses consulted by the gradient field and progress.
+    pub(crate) neighbors: usize,
+}
+
+impl Default for FitParams {
+    fn default() -> Self {
+        FitParams { variance: 0.95, min_dims: 2, max_dims: 8, neighbors: 8 }
+    }
+}
+
+/// Settings that passed [`FitParams::check`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ValidFitParams(pub(crate) FitParams);
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum FitParamsError {
+    #[error("--variance must lie in (0, 1], not {0}")]
+    Variance(f64),
+    #[error("--min-dims must be at least 1")]
+    MinDims,
+    #[error("--max-dims must be between --min-dims ({min}) and {MAX_LATENT_DIMS}, not {max}")]
+    MaxDims { min: usize, max: usize },
+    #[error("the field needs at least one neighbour")]
+    Neighbors,
+}
+
+impl FitParams {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    pub fn variance(mut self, share: f64) -> Self {
+        self.variance = share;
+        self
+    }
+
+    pub fn min_dims(mut self, d: usize) -> Self {
+        self.min_dims = d;
+        self
+    }
+
+    pub fn max_dims(mut self, d: usize) -> Self {
+        self.max_dims = d;
+        self
+    }
+
+    pub fn neighbors(mut self, k: usize) -> Self {
+        self.neighbors = k;
+        self
+    }
+
+    /// Validates the settings; every rule has its own error.
+    pub fn check(&self) -> Result<ValidFitParams, FitParamsError> {
+        if !(self.variance > 0.0 && self.variance <= 1.0) {
+            return Err(FitParamsError::Variance(self.variance));
+        }
+        if self.min_dims == 0 {
+            return Err(FitParamsError::MinDims);
+        }
+        if self.max_dims < self.min_dims || self.max_dims > MAX_LATENT_DIMS {
+            return Err(FitParamsError::MaxDims { min: self.min_dims, max: self.max_dims });
+        }
+        if self.neighbors == 0 {
+            return Err(FitParamsError::Neighbors);
+        }
+        Ok(ValidFitParams(self.clone()))
+    }
+}
+
+impl ValidFitParams {
+    pub fn params(&self) -> &FitParams {
+        &self.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_rule_has_its_own_error() {
+        assert!(FitParams::new().check().is_ok());
+        assert_eq!(FitParams::new().variance(0.0).check(), Err(FitParamsError::Variance(0.0)));
+        assert_eq!(FitParams::new().min_dims(0).check(), Err(FitParamsError::MinDims));
+        assert_eq!(FitParams::new().min_dims(4).max_dims(3).check(), Err(FitParamsError::MaxDims { min: 4, max: 3 }));
+        assert_eq!(FitParams::new().max_dims(13).check(), Err(FitParamsError::MaxDims { min: 2, max: 13 }));
+        assert_eq!(FitParams::new().neighbors(0).check(), Err(FitParamsError::Neighbors));
+    }
+}

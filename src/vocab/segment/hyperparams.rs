@@ -1,0 +1,170 @@
+//! Segmentation settings, checked once.
+
+/// How to find segment boundaries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// Kinematic centroids: a segment ends when the limbs have swung away
+    /// from its first posture and come back.
+    Kcs,
+    /// Zero-velocity crossings: a segment ends where the summed squared
+    /// joint velocity dips.
+    Zvc,
+}
+
+/// Segmentation settings; [`SegmentParams::check`] validates them.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SegmentParams {
+    pub(crate) method: Method,
+    pub(crate) min_length_s: f64,
+    pub(crate) max_length_s: f64,
+    pub(crate) smoothing_s: f64,
+    /// KCS: how close to its start the centroid must come back, as a share
+    /// of its largest excursion.
+    pub(crate) return_share: f64,
+    /// KCS: a return counts as retracing the way out, and the swing is cut
+    /// at its turn, when it keeps closer than this share of its reach to
+    /// the outward path (joint space).
+    pub(crate) retrace_share: f64,
+    /// KCS: the smallest excursion that counts as a swing, meters.
+    pub(crate) min_excursion_m: f64,
+    /// ZVC: how deep an energy dip must be, as a share of the lower of the
+    /// peaks beside it.
+    pub(crate) dip_share: f64,
+}
+
+impl Default for SegmentParams {
+    fn default() -> Self {
+        SegmentParams {
+            method: Method::Kcs,
+            min_length_s: 0.2,
+            max_length_s: 5.0,
+            smoothing_s: 0.05,
+            return_share: 0.5,
+            retrace_share: 0.07,
+            min_excursion_m: 0.05,
+            dip_share: 0.5,
+        }
+    }
+}
+
+/// Settings that passed [`SegmentParams::check`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ValidSegmentParams(pub(crate) SegmentParams);
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum SegmentParamsError {
+    #[error("the minimum segment length must be a positive number of seconds, not {0}")]
+    MinLength(f64),
+    #[error("the maximum segment length ({max} s) must be at least twice the minimum ({min} s)")]
+    MaxLength { min: f64, max: f64 },
+    #[error("the smoothing must be a non-negative number of seconds, not {0}")]
+    Smoothing(f64),
+    #[error("the return share must lie in (0, 1), not {0}")]
+    ReturnShare(f64),
+    #[error("the retrace share must lie in (0, 1), not {0}")]
+    RetraceShare(f64),
+    #[error("the smallest swing must be a non-negative number of meters, not {0}")]
+    MinExcursion(f64),
+    #[error("the dip share must lie in (0, 1), not {0}")]
+    DipShare(f64),
+}
+
+impl SegmentParams {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    pub fn method(mut self, method: Method) -> Self {
+        self.method = method;
+        self
+    }
+
+    pub fn min_length_s(mut self, seconds: f64) -> Self {
+        self.min_length_s = seconds;
+        self
+    }
+
+    pub fn max_length_s(mut self, seconds: f64) -> Self {
+        self.max_length_s = seconds;
+        self
+    }
+
+    pub fn smoothing_s(mut self, seconds: f64) -> Self {
+        self.smoothing_s = seconds;
+        self
+    }
+
+    pub fn return_share(mut self, share: f64) -> Self {
+        self.return_share = share;
+        self
+    }
+
+    pub fn retrace_share(mut self, share: f64) -> Self {
+        self.retrace_share = share;
+        self
+    }
+
+    pub fn min_excursion_m(mut self, meters: f64) -> Self {
+        self.min_excursion_m = meters;
+        self
+    }
+
+    pub fn dip_share(mut self, share: f64) -> Self {
+        self.dip_share = share;
+        self
+    }
+
+    /// Validates the settings; every rule has its own error.
+    pub fn check(&self) -> Result<ValidSegmentParams, SegmentParamsError> {
+        let p = self;
+        let unit = |x: f64| x > 0.0 && x < 1.0;
+        if !(p.min_length_s > 0.0 && p.min_length_s.is_finite()) {
+            return Err(SegmentParamsError::MinLength(p.min_length_s));
+        }
+        // Twice, so a long segment can always be split into two legal ones.
+        if !(p.max_length_s >= 2.0 * p.min_length_s && p.max_length_s.is_finite()) {
+            return Err(SegmentParamsError::MaxLength { min: p.min_length_s, max: p.max_length_s });
+        }
+        if !(p.smoothing_s >= 0.0 && p.smoothing_s.is_finite()) {
+            return Err(SegmentParamsError::Smoothing(p.smoothing_s));
+        }
+        if !unit(p.return_share) {
+            return Err(SegmentParamsError::ReturnShare(p.return_share));
+        }
+        if !unit(p.retrace_share) {
+            return Err(SegmentParamsError::RetraceShare(p.retrace_share));
+        }
+        if !(p.min_excursion_m >= 0.0 && p.min_excursion_m.is_finite()) {
+            return Err(SegmentParamsError::MinExcursion(p.min_excursion_m));
+        }
+        if !unit(p.dip_share) {
+            return Err(SegmentParamsError::DipShare(p.dip_share));
+        }
+        Ok(ValidSegmentParams(self.clone()))
+    }
+}
+
+impl ValidSegmentParams {
+    pub fn params(&self) -> &SegmentParams {
+        &self.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_rule_has_its_own_error() {
+        let p = SegmentParams::new();
+        assert!(p.check().is_ok());
+        assert_eq!(p.clone().min_length_s(0.0).check(), Err(SegmentParamsError::MinLength(0.0)));
+        assert_eq!(p.clone().max_length_s(0.1).check(), Err(SegmentParamsError::MaxLength { min: 0.2, max: 0.1 }));
+        assert_eq!(p.clone().smoothing_s(-1.0).check(), Err(SegmentParamsError::Smoothing(-1.0)));
+        assert_eq!(p.clone().return_share(1.0).check(), Err(SegmentParamsError::ReturnShare(1.0)));
+        assert_eq!(p.clone().retrace_share(0.0).check(), Err(SegmentParamsError::RetraceShare(0.0)));
+        assert!(p.clone().min_excursion_m(f64::NAN).check().unwrap_err().to_string().contains("NaN"));
+        assert_eq!(p.dip_share(0.0).check(), Err(SegmentParamsError::DipShare(0.0)));
+    }
+}
