@@ -3,9 +3,16 @@
 //! Exit codes: 0 success, 1 some inputs failed (each reported), 2 usage
 //! error (unknown flag, impossible option value).
 
+mod cluster;
+mod embed;
+mod export;
+mod fit;
 mod inspect;
+mod learn;
 mod retarget;
+mod segment;
 mod synth;
+mod vocab;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -36,6 +43,12 @@ enum Command {
     Inspect(inspect::Args),
     Retarget(retarget::Args),
     Synth(synth::Args),
+    Segment(segment::Args),
+    Embed(embed::Args),
+    Cluster(cluster::Args),
+    Fit(fit::Args),
+    Export(export::Args),
+    Vocab(vocab::Args),
 }
 
 /// How a command ended, when it did not fail outright.
@@ -56,6 +69,12 @@ pub fn main() -> ExitCode {
         Command::Inspect(args) => inspect::run(args, cli.global),
         Command::Retarget(args) => retarget::run(args, cli.global),
         Command::Synth(args) => synth::run(args, cli.global),
+        Command::Segment(args) => segment::run(args, cli.global),
+        Command::Embed(args) => embed::run(args, cli.global),
+        Command::Cluster(args) => cluster::run(args, cli.global),
+        Command::Fit(args) => fit::run(args, cli.global),
+        Command::Export(args) => export::run(args, cli.global),
+        Command::Vocab(args) => vocab::run(args, cli.global),
     };
     match result {
         Ok(Outcome::Success) => ExitCode::SUCCESS,

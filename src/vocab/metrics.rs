@@ -53,15 +53,16 @@ fn contingency<'a>(clusters: &[usize], labels: &[Option<&'a str>]) -> BTreeMap<u
     table
 }
 
-/// The most common label of each cluster (ties go to the label that sorts
-/// first), `None` for a cluster without labelled items.
+/// The label of each cluster: the one held by more than half of its
+/// labelled items; `None` where no label has such a majority (a cluster
+/// that mixes activities has no one name) or nothing is labelled.
 pub fn majority_labels<'a>(clusters: &[usize], labels: &[Option<&'a str>], k: usize) -> Vec<Option<&'a str>> {
     let table = contingency(clusters, labels);
     (0..k)
         .map(|c| {
             let row = table.get(&c)?;
-            let best = row.values().copied().max()?;
-            row.iter().find(|(_, n)| **n == best).map(|(label, _)| *label)
+            let total: usize = row.values().sum();
+            row.iter().find(|(_, n)| 2 * **n > total).map(|(label, _)| *label)
         })
         .collect()
 }
@@ -158,9 +159,10 @@ mod tests {
     }
 
     #[test]
-    fn majority_labels_break_ties_by_name_and_skip_empty_clusters() {
-        let l = labels(&["b", "a", "c"]);
-        assert_eq!(majority_labels(&[0, 0, 2], &l, 3), vec![Some("a"), None, Some("c")]);
+    fn a_cluster_is_named_only_by_a_label_held_by_more_than_half() {
+        let l = labels(&["b", "a", "c", "a", "a", "b", "d"]);
+        // Cluster 0: b, a (a tie); 1: empty; 2: c, a, a; 3: b, d.
+        assert_eq!(majority_labels(&[0, 0, 2, 2, 2, 3, 3], &l, 4), vec![None, None, Some("a"), None]);
     }
 
     #[test]

@@ -16,5 +16,6 @@ pub mod phase;
 pub mod pipeline;
 pub mod primitive;
 pub mod segment;
+pub mod stages;
 pub mod table;
 pub mod vocabulary;

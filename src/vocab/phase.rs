@@ -52,6 +52,11 @@ impl<'a> ArcPath<'a> {
         ArcPath { motion, span, lengths: moving.then_some(lengths) }
     }
 
+    /// The path's length in joint space (0 for a still span).
+    pub fn length(&self) -> f64 {
+        self.lengths.as_ref().map_or(0.0, |l| l[l.len() - 1])
+    }
+
     /// How far along the path frame `t` of the span lies, in [0, 1].
     pub fn fraction_at_frame(&self, t: usize) -> f64 {
         let i = t - self.span.first;
@@ -125,6 +130,123 @@ impl PhaseAxes {
         });
         (-im.atan2(re) / TAU).rem_euclid(1.0)
     }
+}
+
+/// Rounds of template refinement in [`CycleTemplate::fit`].
+const ALIGN_ROUNDS: usize = 3;
+
+/// The mean cycle of one movement, and where each of its cycles starts.
+///
+/// Within one primitive this registers phase more exactly than the
+/// corpus-wide first harmonic, which reads phase along axes shared by every
+/// movement and so wavers where a movement's shape varies between
+/// repetitions; and it places partial swings (cut where a take starts,
+/// ends or changes activity) on the cycle, so their phase agrees with the
+/// whole cycles'.
+pub struct CycleTemplate {
+    /// Poses at phases `origin + k / SAMPLES`, k = 0, 1, ….
+    poses: Vec<JointVector>,
+    origin: f64,
+    /// Mean path length of a cycle (joint space).
+    length: f64,
+    /// Each cycle's registered start, in the order given.
+    pub offsets: Vec<f64>,
+}
+
+impl CycleTemplate {
+    /// Registers whole cycles against each other: each cycle, sampled along
+    /// its path from its current start (`offset`), is turned to the shift
+    /// that best matches the template (least squared distance, refined
+    /// between samples by a parabola), the template being the mean of the
+    /// turned cycles, over a few rounds. Corrections are centred (their
+    /// circular mean is zero) so the common start stays where the
+    /// corpus-wide registration put it on average. `None` without cycles.
+    pub fn fit(cycles: &[(&Motion, Span, f64)]) -> Option<CycleTemplate> {
+        let n = SAMPLES;
+        let paths: Vec<ArcPath> = cycles.iter().map(|&(motion, span, _)| ArcPath::new(motion, span)).collect();
+        let sampled: Vec<Vec<JointVector>> = paths
+            .iter()
+            .zip(cycles)
+            .map(|(path, &(_, _, offset))| {
+                (0..n).map(|k| path.pose_at((offset + k as f64 / n as f64).rem_euclid(1.0))).collect()
+            })
+            .collect();
+        let mut poses = sampled.first()?.clone();
+        let mut shifts = vec![0.0; cycles.len()];
+        for _ in 0..ALIGN_ROUNDS {
+            for (shift, cycle) in shifts.iter_mut().zip(&sampled) {
+                *shift = best_shift(n, |s| (0..n).map(|k| squared_distance(&cycle[(k + s) % n], &poses[k])).sum());
+            }
+            poses = (0..n)
+                .map(|k| {
+                    let mut mean = [0.0; DOF];
+                    for (cycle, &shift) in sampled.iter().zip(&shifts) {
+                        let at = (k + shift.round() as usize) % n;
+                        mean.iter_mut().zip(&cycle[at]).for_each(|(m, x)| *m += x / cycles.len() as f64);
+                    }
+                    mean
+                })
+                .collect();
+        }
+        let (sin, cos) = shifts.iter().fold((0.0, 0.0), |(s, c), &shift| {
+            let angle = TAU * shift / n as f64;
+            (s + angle.sin(), c + angle.cos())
+        });
+        let centre = if sin == 0.0 && cos == 0.0 { 0.0 } else { sin.atan2(cos) / TAU };
+        let offsets = cycles
+            .iter()
+            .zip(&shifts)
+            .map(|(&(_, _, offset), shift)| (offset + shift / n as f64 - centre).rem_euclid(1.0))
+            .collect();
+        // Sample k of cycle i lies at phase (k + shift) / n from its first
+        // sample, which is at phase shift / n - centre: k / n + centre.
+        let length = paths.iter().map(ArcPath::length).sum::<f64>() / paths.len() as f64;
+        Some(CycleTemplate { poses, origin: centre, length, offsets })
+    }
+
+    /// The template pose at `phase`, interpolated between samples.
+    fn pose_at(&self, phase: f64) -> JointVector {
+        let n = self.poses.len();
+        let q = (phase - self.origin).rem_euclid(1.0) * n as f64;
+        let (i, t) = (q.floor() as usize % n, q.fract());
+        let (a, b) = (&self.poses[i], &self.poses[(i + 1) % n]);
+        std::array::from_fn(|k| a[k] + (b[k] - a[k]) * t)
+    }
+
+    /// Where a partial swing lies on the cycle: the phase of its first pose
+    /// and the share of a cycle it covers (its path length over a cycle's,
+    /// at most 1). Its frames' phases are then `start + share × fraction`.
+    pub fn place(&self, motion: &Motion, span: Span) -> (f64, f64) {
+        let path = ArcPath::new(motion, span);
+        let share = (path.length() / self.length).min(1.0);
+        let m = SAMPLES;
+        let samples: Vec<JointVector> = (0..m).map(|j| path.pose_at(j as f64 / (m - 1) as f64)).collect();
+        let cost = |start: f64| -> f64 {
+            samples
+                .iter()
+                .enumerate()
+                .map(|(j, x)| squared_distance(x, &self.pose_at(start + share * j as f64 / (m - 1) as f64)))
+                .sum()
+        };
+        let n = self.poses.len();
+        let start = best_shift(n, |s| cost(s as f64 / n as f64)) / n as f64;
+        (start.rem_euclid(1.0), share)
+    }
+}
+
+/// The shift in 0..n with the least `cost`, refined between neighbours by
+/// a parabola through the costs on either side (circularly).
+fn best_shift(n: usize, cost: impl Fn(usize) -> f64) -> f64 {
+    let costs: Vec<f64> = (0..n).map(cost).collect();
+    let best = (0..n).min_by(|&a, &b| costs[a].total_cmp(&costs[b])).expect("n > 0");
+    let (left, right) = (costs[(best + n - 1) % n], costs[(best + 1) % n]);
+    let curvature = left - 2.0 * costs[best] + right;
+    let refine = if curvature > 0.0 { 0.5 * (left - right) / curvature } else { 0.0 };
+    best as f64 + refine.clamp(-0.5, 0.5)
+}
+
+fn squared_distance(a: &JointVector, b: &JointVector) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum()
 }
 
 #[cfg(test)]

@@ -111,8 +111,9 @@ pub fn embed_segments(
     Ok(params.embed(&vectors, &next)?)
 }
 
-/// Primitive names: each cluster's majority label where segments are
-/// labelled (a repeated label gets `-2`, `-3`, …), else `p0`, `p1`, ….
+/// Primitive names: each cluster's majority label (held by more than half
+/// its labelled segments; a repeated label gets `-2`, `-3`, …), else
+/// `p<i>` for cluster `i`.
 pub fn primitive_names(rows: &[SegmentRow], clustering: &Clustering) -> Vec<String> {
     let labels: Vec<Option<&str>> = rows.iter().map(|r| r.label.as_deref()).collect();
     let majorities = majority_labels(clustering.assignments(), &labels, clustering.k());

@@ -39,9 +39,14 @@
 //!   pyarrow: `table.replace_schema_metadata({"imitate.table": "segments"})`).
 //! - **CSV:** the first line, before the header, is exactly
 //!   `# imitate <kind> table`. CSV has no metadata, and a line of its own
-//!   keeps the data columns clean; to read the file elsewhere skip one line
-//!   (pandas `read_csv(path, skiprows=1)`, polars `skip_lines=1`), and to
-//!   write one, print that line before the CSV.
+//!   keeps the data columns clean; to read the file elsewhere skip the
+//!   leading `#` lines (pandas `read_csv(path, skiprows=n)`, polars
+//!   `skip_lines=n`), and to write one, print that line before the CSV.
+//!
+//! A table may also carry notes about how it was made (each stage records
+//! its settings as one line of JSON under `build`): Parquet key-value
+//! metadata `imitate.<key> = <value>`, or CSV lines `# <key>: <value>`
+//! after the first line.
 //!
 //! [`Table::read`] refuses a file without this declaration, or of another
 //! kind, naming the file, the kind found and the kind expected.
@@ -88,6 +93,10 @@ use crate::fsutil;
 
 /// The Parquet key-value metadata key that holds a table's kind.
 pub const PARQUET_KIND_KEY: &str = "imitate.table";
+/// Parquet key-value metadata keys of table notes start with this.
+const PARQUET_PREFIX: &str = "imitate.";
+/// The note key reserved for the kind.
+const KIND_KEY: &str = "table";
 
 /// The type of a column of a stage table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -192,6 +201,8 @@ pub struct Table {
     /// What the table holds, e.g. `"segments"`; written into the file.
     pub kind: &'static str,
     columns: Vec<(String, Values)>,
+    /// Named one-line texts about the whole table (how it was made).
+    meta: Vec<(String, String)>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -228,7 +239,7 @@ impl Table {
     /// (a programming error: kinds are constants).
     pub fn new(kind: &'static str) -> Self {
         assert!(valid_kind(kind), "table kind {kind:?} must be a non-empty word of ASCII letters, digits, `_`, `-`");
-        Table { kind, columns: Vec::new() }
+        Table { kind, columns: Vec::new(), meta: Vec::new() }
     }
 
     /// Appends a column.
@@ -252,6 +263,25 @@ impl Table {
         }
         self.columns.push((name.to_owned(), values));
         self
+    }
+
+    /// Sets a table-wide note: `key` a word (as kinds are), `value` one
+    /// line of text.
+    ///
+    /// # Panics
+    /// If `key` is not a word or `value` holds a line break (programming
+    /// errors: keys are constants, values compact JSON).
+    pub fn set_meta(&mut self, key: &str, value: String) -> &mut Self {
+        assert!(valid_kind(key) && key != KIND_KEY, "table meta key {key:?} must be a word other than `{KIND_KEY}`");
+        assert!(!value.contains(['\n', '\r']), "table meta `{key}` must be one line");
+        self.meta.retain(|(k, _)| k != key);
+        self.meta.push((key.to_owned(), value));
+        self
+    }
+
+    /// A table-wide note set with [`Table::set_meta`] (or read from the file).
+    pub fn meta(&self, key: &str) -> Option<&str> {
+        self.meta.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str())
     }
 
     /// The number of rows (0 for a table without columns).
@@ -356,7 +386,10 @@ impl Table {
         fsutil::write_atomic(path, |out| {
             match format {
                 Format::Parquet => {
-                    let metadata = KeyValueMetadata::from_static(vec![(PARQUET_KIND_KEY.to_owned(), kind.to_owned())]);
+                    let pairs = std::iter::once((PARQUET_KIND_KEY.to_owned(), kind.to_owned()))
+                        .chain(self.meta.iter().map(|(k, v)| (format!("{PARQUET_PREFIX}{k}"), v.clone())))
+                        .collect();
+                    let metadata = KeyValueMetadata::from_static(pairs);
                     ParquetWriter::new(&mut *out)
                         .with_compression(ParquetCompression::Zstd(None))
                         .with_key_value_metadata(Some(metadata))
@@ -365,6 +398,9 @@ impl Table {
                 }
                 Format::Csv => {
                     writeln!(out, "# imitate {kind} table")?;
+                    for (key, value) in &self.meta {
+                        writeln!(out, "# {key}: {value}")?;
+                    }
                     CsvWriter::new(&mut *out)
                         .include_header(true)
                         .include_bom(false)
@@ -414,7 +450,7 @@ impl Table {
         let ctx = Ctx { path: display, kind };
         let bytes =
             std::fs::read(path).map_err(|source| TableError::Io { path: ctx.path.clone(), action: "read", source })?;
-        let columns = catch_unwind(AssertUnwindSafe(|| match format {
+        let read = catch_unwind(AssertUnwindSafe(|| match format {
             Format::Parquet => read_parquet(&ctx, bytes, schema),
             Format::Csv => read_csv(&ctx, &bytes, schema),
         }))
@@ -425,8 +461,9 @@ impl Table {
                 .or_else(|| panic.downcast_ref::<String>().cloned())
                 .unwrap_or_else(|| "the reader failed".to_owned());
             Err(ctx.unreadable(format, format!("polars panicked: {message}")))
-        })?;
-        Ok(Table { kind, columns })
+        });
+        let (columns, meta) = read?;
+        Ok(Table { kind, columns, meta })
     }
 }
 
@@ -502,7 +539,10 @@ impl Ctx {
     }
 }
 
-fn read_parquet(ctx: &Ctx, bytes: Vec<u8>, schema: &[(&str, ColumnType)]) -> Result<Vec<(String, Values)>, TableError> {
+/// A table's columns and notes, as read.
+type Read = (Vec<(String, Values)>, Vec<(String, String)>);
+
+fn read_parquet(ctx: &Ctx, bytes: Vec<u8>, schema: &[(&str, ColumnType)]) -> Result<Read, TableError> {
     let unreadable = |e: PolarsError| ctx.unreadable(Format::Parquet, brief(&e));
     let mut reader = ParquetReader::new(Cursor::new(bytes));
     let metadata = reader.get_metadata().map_err(unreadable)?;
@@ -520,17 +560,25 @@ fn read_parquet(ctx: &Ctx, bytes: Vec<u8>, schema: &[(&str, ColumnType)]) -> Res
         });
     };
     ctx.check_kind(&found)?;
+    let meta = metadata
+        .key_value_metadata()
+        .iter()
+        .flatten()
+        .filter(|kv| kv.key != PARQUET_KIND_KEY)
+        .filter_map(|kv| Some((kv.key.strip_prefix(PARQUET_PREFIX)?.to_owned(), kv.value.clone()?)))
+        .collect();
     let present: Vec<String> = reader.schema().map_err(unreadable)?.iter_names().map(|n| n.to_string()).collect();
     let wanted = ctx.resolve(&present, schema)?;
     let df = reader.with_columns(Some(wanted.iter().map(|(n, _)| n.clone()).collect())).finish().map_err(unreadable)?;
-    wanted
+    let columns = wanted
         .into_iter()
         .map(|(name, ty)| {
             let column = df.column(&name).map_err(unreadable)?;
             let values = parquet_values(ctx, &name, ty, column)?;
             Ok((name, values))
         })
-        .collect()
+        .collect::<Result<_, TableError>>()?;
+    Ok((columns, meta))
 }
 
 fn parquet_values(ctx: &Ctx, name: &str, ty: ColumnType, column: &Column) -> Result<Values, TableError> {
@@ -607,7 +655,7 @@ fn parquet_values(ctx: &Ctx, name: &str, ty: ColumnType, column: &Column) -> Res
     }
 }
 
-fn read_csv(ctx: &Ctx, bytes: &[u8], schema: &[(&str, ColumnType)]) -> Result<Vec<(String, Values)>, TableError> {
+fn read_csv(ctx: &Ctx, bytes: &[u8], schema: &[(&str, ColumnType)]) -> Result<Read, TableError> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let line_end = bytes.iter().position(|&b| b == b'\n').map_or(bytes.len(), |i| i + 1);
     let first = String::from_utf8_lossy(&bytes[..line_end]);
@@ -624,7 +672,17 @@ fn read_csv(ctx: &Ctx, bytes: &[u8], schema: &[(&str, ColumnType)]) -> Result<Ve
         });
     };
     ctx.check_kind(found)?;
-    let rest = &bytes[line_end..];
+    // Notes: `# key: value` lines before the header.
+    let mut rest = &bytes[line_end..];
+    let mut meta = Vec::new();
+    while let Some(line) = rest.strip_prefix(b"# ") {
+        let end = line.iter().position(|&b| b == b'\n').map_or(line.len(), |i| i + 1);
+        let text = String::from_utf8_lossy(&line[..end]);
+        if let Some((key, value)) = text.trim_end_matches(['\n', '\r']).split_once(": ") {
+            meta.push((key.to_owned(), value.to_owned()));
+        }
+        rest = &line[end..];
+    }
     if rest.iter().all(u8::is_ascii_whitespace) {
         return Err(ctx.unreadable(Format::Csv, "no header line after the first line".to_owned()));
     }
@@ -639,14 +697,15 @@ fn read_csv(ctx: &Ctx, bytes: &[u8], schema: &[(&str, ColumnType)]) -> Result<Ve
         .map_err(|e| ctx.unreadable(Format::Csv, brief(&e)))?;
     let present: Vec<String> = df.get_column_names().iter().map(|n| n.to_string()).collect();
     let wanted = ctx.resolve(&present, schema)?;
-    wanted
+    let columns = wanted
         .into_iter()
         .map(|(name, ty)| {
             let text = df.column(&name).and_then(|c| c.str()).map_err(|e| ctx.unreadable(Format::Csv, brief(&e)))?;
             let values = csv_values(ctx, &name, ty, text)?;
             Ok((name, values))
         })
-        .collect()
+        .collect::<Result<_, TableError>>()?;
+    Ok((columns, meta))
 }
 
 fn csv_values(ctx: &Ctx, name: &str, ty: ColumnType, text: &StringChunked) -> Result<Values, TableError> {
@@ -834,6 +893,25 @@ mod tests {
         let table = tricky();
         table.write(&path).unwrap();
         assert_same(&Table::read(&path, "segments", SEGMENTS).unwrap(), &table);
+    }
+
+    #[test]
+    fn notes_round_trip_in_both_formats_and_the_data_stays_readable() {
+        let dir = tempfile::tempdir().unwrap();
+        for name in ["notes.parquet", "notes.csv"] {
+            let path = dir.path().join(name);
+            let mut table = tricky();
+            table.set_meta("build", r#"{"segment":{"method":"kcs"},"note":"a: b # c"}"#.into());
+            table.set_meta("made_by", "imitate 0.1.0".into());
+            table.write(&path).unwrap();
+            let back = Table::read(&path, "segments", SEGMENTS).unwrap();
+            assert_same(&back, &table);
+            assert_eq!(back.meta("build"), table.meta("build"), "{name}");
+            assert_eq!(back.meta("made_by"), Some("imitate 0.1.0"), "{name}");
+            assert_eq!(back.meta("absent"), None);
+        }
+        let csv = fs::read_to_string(dir.path().join("notes.csv")).unwrap();
+        assert!(csv.starts_with("# imitate segments table\n# build: {"), "{csv}");
     }
 
     #[test]

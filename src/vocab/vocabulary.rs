@@ -5,11 +5,9 @@
 
 use crate::fsutil::write_atomic;
 use crate::mocap::body::{Body, DOF, Joint, JointVector, Kind, Proportions};
-use crate::vocab::cluster::{Choice, ClusterParams};
 use crate::vocab::container::{Container, ContainerError};
-use crate::vocab::embed::EmbedParams;
 use crate::vocab::primitive::{Field, FitParams, Primitive, Source, SpeedStats};
-use crate::vocab::segment::SegmentParams;
+use crate::vocab::stages::Lineage;
 use std::io::Write;
 use std::path::Path;
 
@@ -79,18 +77,17 @@ impl BodySignature {
 /// How a vocabulary was built.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BuildInfo {
-    /// The imitate version that built it.
-    pub imitate: String,
-    pub segment: SegmentParams,
-    pub embed: EmbedParams,
-    pub cluster: ClusterParams,
-    pub k_choice: Choice,
-    /// Mean silhouette of the clustering.
-    pub silhouette: Option<f64>,
+    /// The settings of segmenting, embedding and clustering.
+    #[serde(flatten)]
+    pub lineage: Lineage,
     pub fit: FitParams,
+    /// The files learned from.
     pub takes: Vec<String>,
     pub frames: usize,
     pub segments: usize,
+    /// Clusters left out because their poses never change.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub still: Vec<String>,
 }
 
 /// A primitive's small fields, kept in the header.

@@ -32,10 +32,10 @@ pub struct Clustering {
 }
 
 impl Clustering {
-    /// Assignments read back from a table.
-    pub fn from_assignments(assignments: Vec<usize>) -> Clustering {
+    /// A clustering read back from a table, with how its k was chosen.
+    pub fn recorded(assignments: Vec<usize>, choice: Choice, scores: Vec<(usize, f64)>) -> Clustering {
         let k = assignments.iter().max().map_or(0, |m| m + 1);
-        Clustering { assignments, k, choice: Choice::Given, scores: Vec::new() }
+        Clustering { assignments, k, choice, scores }
     }
 
     pub fn assignments(&self) -> &[usize] {
@@ -90,18 +90,25 @@ impl ValidClusterParams {
                 if n < 3 {
                     return Err(ClusterError::TooFewSegments(n));
                 }
-                let mut best: Option<(f64, Vec<usize>)> = None;
+                // The best of all, and the best with clusters of min_size.
+                let mut best: [Option<(f64, Vec<usize>)>; 2] = [None, None];
                 let mut scores = Vec::new();
                 for k in 2..=p.max_k.min(n - 1) {
                     let a = self.kmeans(&records, k)?;
                     let score = silhouette(&records, &a);
                     scores.push((k, score));
-                    // Strictly better only: ties keep the fewer primitives.
-                    if best.as_ref().is_none_or(|(s, _)| score > *s) {
-                        best = Some((score, a));
+                    let mut sizes = vec![0; k];
+                    a.iter().for_each(|&c| sizes[c] += 1);
+                    let sized = sizes.iter().all(|&s| s >= p.min_size);
+                    for (slot, eligible) in best.iter_mut().zip([true, sized]) {
+                        // Strictly better only: ties keep the fewer primitives.
+                        if eligible && slot.as_ref().is_none_or(|(s, _)| score > *s) {
+                            *slot = Some((score, a.clone()));
+                        }
                     }
                 }
-                let (_, a) = best.expect("k = 2 is always tried");
+                let [any, sized] = best;
+                let (_, a) = sized.or(any).expect("k = 2 is always tried");
                 (a, Choice::Silhouette, scores)
             }
         };
@@ -196,7 +203,7 @@ mod tests {
             let c = centres[(i * 7) % 3];
             coords.extend([c[0] + 0.1 * (i as f64).sin(), c[1] + 0.1 * (i as f64).cos()]);
         }
-        Embedding::new(coords, 2)
+        Embedding::new(coords, 2, Vec::new())
     }
 
     #[test]

@@ -4,18 +4,27 @@
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ClusterParams {
     /// The number of primitives; chosen from the data when `None`.
-    pub(crate) k: Option<usize>,
+    pub k: Option<usize>,
     /// The largest number tried when choosing.
-    pub(crate) max_k: usize,
+    pub max_k: usize,
     /// k-means restarts; the one with the least inertia wins.
-    pub(crate) runs: usize,
-    pub(crate) seed: u64,
+    pub runs: usize,
+    /// When choosing k, only clusterings whose every cluster holds at least
+    /// this many segments compete (a primitive fitted to one segment has
+    /// nothing to generalize from); if none does, all do.
+    #[serde(default = "default_min_size")]
+    pub min_size: usize,
+    pub seed: u64,
 }
 
 impl Default for ClusterParams {
     fn default() -> Self {
-        ClusterParams { k: None, max_k: 24, runs: 10, seed: 1 }
+        ClusterParams { k: None, max_k: 24, runs: 10, min_size: default_min_size(), seed: 1 }
     }
+}
+
+fn default_min_size() -> usize {
+    2
 }
 
 /// Settings that passed [`ClusterParams::check`].
@@ -49,6 +58,11 @@ impl ClusterParams {
 
     pub fn runs(mut self, runs: usize) -> Self {
         self.runs = runs;
+        self
+    }
+
+    pub fn min_size(mut self, segments: usize) -> Self {
+        self.min_size = segments;
         self
     }
 

@@ -26,9 +26,11 @@ pub struct Embedding {
 }
 
 impl Embedding {
-    pub fn new(coords: Vec<f64>, dims: usize) -> Embedding {
+    /// Coordinates read back (from a table), with the MDS eigenvalues if
+    /// known.
+    pub fn new(coords: Vec<f64>, dims: usize, eigenvalues: Vec<f64>) -> Embedding {
         assert_eq!(coords.len() % dims.max(1), 0, "coordinates fill whole rows");
-        Embedding { coords, dims, eigenvalues: Vec::new(), atn_edges: 0, ctn_edges: 0, joined_components: 0 }
+        Embedding { coords, dims, eigenvalues, atn_edges: 0, ctn_edges: 0, joined_components: 0 }
     }
 
     pub fn dims(&self) -> usize {

@@ -5,20 +5,20 @@ use crate::vocab::eigen::EigenMethod;
 /// ST-Isomap settings; [`EmbedParams::check`] validates them.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct EmbedParams {
-    pub(crate) neighbors: usize,
-    pub(crate) dims: usize,
-    pub(crate) resample: usize,
+    pub neighbors: usize,
+    pub dims: usize,
+    pub resample: usize,
     /// Adjacent temporal neighbours (consecutive segments of a take):
     /// their distance is divided by this.
-    pub(crate) c_atn: f64,
+    pub c_atn: f64,
     /// Common temporal neighbours (neighbouring segments whose successors,
     /// or predecessors, are neighbours too): their distance is divided by
     /// this.
-    pub(crate) c_ctn: f64,
+    pub c_ctn: f64,
     /// False for plain Isomap: no temporal edges, no shrinking.
-    pub(crate) temporal: bool,
+    pub temporal: bool,
     #[serde(skip)]
-    pub(crate) eigen: EigenMethod,
+    pub eigen: EigenMethod,
 }
 
 impl Default for EmbedParams {

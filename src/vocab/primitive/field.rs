@@ -83,7 +83,7 @@ impl Field {
         self.weighted_neighbours(query, &mut found);
         out.fill(0.0);
         for &(i, w) in &found {
-            for (o, v) in out.iter_mut().zip(&self.velocities[i * self.dims..(i + 1) * self.dims]) {
+            for (o, v) in out.iter_mut().zip(self.velocity(i)) {
                 *o += w * v;
             }
         }
@@ -98,17 +98,43 @@ impl Field {
     /// Attractor progress at `query`: the weighted mean of the neighbours'
     /// phases in [0, 1), taken on the circle, because a segment ends close
     /// to where the next one starts, and 0.98 and 0.02 should average to 0,
-    /// not 0.5.
+    /// not 0.5. Each neighbour's weight is scaled by how well its motion
+    /// agrees with the field's direction here, so where two parts of a
+    /// cycle pass close to each other in opposite directions (the way up
+    /// and the way down of a wave), the part moving the way the field
+    /// moves decides.
     pub fn phase(&self, query: &[f64]) -> f64 {
         let mut found = Vec::with_capacity(self.neighbors);
         self.weighted_neighbours(query, &mut found);
-        let (mut s, mut c) = (0.0, 0.0);
+        let mut flow = vec![0.0; self.dims];
         for &(i, w) in &found {
-            let angle = TAU * self.phases[i];
-            s += w * angle.sin();
-            c += w * angle.cos();
+            flow.iter_mut().zip(self.velocity(i)).for_each(|(f, v)| *f += w * v);
+        }
+        let agreement = |i: usize| -> f64 {
+            let v = self.velocity(i);
+            let dot: f64 = v.iter().zip(&flow).map(|(a, b)| a * b).sum();
+            let norms = v.iter().map(|a| a * a).sum::<f64>().sqrt() * flow.iter().map(|a| a * a).sum::<f64>().sqrt();
+            if norms > 0.0 { (dot / norms).max(0.0) } else { 0.0 }
+        };
+        let circular_mean = |weight: &dyn Fn(usize, f64) -> f64| {
+            let (mut s, mut c) = (0.0, 0.0);
+            for &(i, w) in &found {
+                let (sin, cos) = (TAU * self.phases[i]).sin_cos();
+                s += weight(i, w) * sin;
+                c += weight(i, w) * cos;
+            }
+            (s, c)
+        };
+        let (mut s, mut c) = circular_mean(&|i, w| w * agreement(i));
+        if s == 0.0 && c == 0.0 {
+            // No neighbour moves (or the field vanishes): plain weights.
+            (s, c) = circular_mean(&|_, w| w);
         }
         (s.atan2(c) / TAU).rem_euclid(1.0)
+    }
+
+    fn velocity(&self, i: usize) -> &[f64] {
+        &self.velocities[i * self.dims..(i + 1) * self.dims]
     }
 }
 

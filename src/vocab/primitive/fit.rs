@@ -8,7 +8,7 @@ use super::model::{Primitive, Source, SpeedStats};
 use crate::mocap::body::{DOF, JointVector};
 use crate::mocap::pose::Motion;
 use crate::vocab::pca::principal_components;
-use crate::vocab::phase::ArcPath;
+use crate::vocab::phase::{ArcPath, CycleTemplate};
 use crate::vocab::segment::Span;
 use rayon::prelude::*;
 
@@ -44,12 +44,25 @@ struct Frames {
 
 fn gather(segments: &[TrainingSegment]) -> Frames {
     let n: usize = segments.iter().map(|s| s.span.frames()).sum();
+    // Phase is counted from each cycle's start as registered against the
+    // primitive's other cycles; partial swings are placed on the mean
+    // cycle. Without cycles, phase runs from 0 to 1 along each segment.
+    let cycles: Vec<(&Motion, Span, f64)> =
+        segments.iter().filter_map(|s| s.phase_offset.map(|o| (s.motion, s.span, o))).collect();
+    let template = CycleTemplate::fit(&cycles);
+    let mut aligned = template.as_ref().map(|t| t.offsets.iter().copied());
     let mut frames =
         Frames { poses: Vec::with_capacity(n), velocities: Vec::with_capacity(n), phases: Vec::with_capacity(n) };
     for s in segments {
         let poses = &s.motion.poses;
         let last_frame = poses.len() - 1;
         let path = ArcPath::new(s.motion, s.span);
+        // Phase = start + share × fraction along the path.
+        let (start, share) = match (&template, s.phase_offset) {
+            (Some(_), Some(_)) => (-aligned.as_mut().and_then(Iterator::next).expect("one per cycle"), 1.0),
+            (Some(t), None) => t.place(s.motion, s.span),
+            (None, _) => (0.0, 1.0),
+        };
         for t in s.span.first..=s.span.last {
             // The next frame of the take (the previous one at its very end).
             let (a, b) = if t < last_frame { (t, t + 1) } else { (t - 1, t) };
@@ -60,7 +73,7 @@ fn gather(segments: &[TrainingSegment]) -> Frames {
             frames.poses.push(poses[t].x);
             frames.velocities.push(v);
             let along = path.fraction_at_frame(t);
-            frames.phases.push(s.phase_offset.map_or(along, |o| (along - o).rem_euclid(1.0)));
+            frames.phases.push((start + share * along).rem_euclid(1.0));
         }
     }
     frames
@@ -153,12 +166,16 @@ mod tests {
     fn pca_keeps_the_asked_variance_in_the_fewest_dimensions() {
         let take = activity_take(Activity::Circles, &SynthOptions::default());
         let segments = segments_of(&take.motion);
-        let fitted = FitParams::new().variance(0.95).max_dims(12).check().unwrap().fit("circles", &segments).unwrap();
+        let params = FitParams::new().variance(0.95).min_dims(1).max_dims(12).check().unwrap();
+        let fitted = params.fit("circles", &segments).unwrap();
         assert!(fitted.variance_kept() >= 0.95, "{}", fitted.variance_kept());
         let one_fewer: f64 = fitted.variances()[..fitted.dims() - 1].iter().sum::<f64>()
             / fitted.variances().iter().sum::<f64>()
             * fitted.variance_kept();
-        assert!(fitted.dims() == 2 || one_fewer < 0.95);
+        assert!(one_fewer < 0.95, "{} dimensions where fewer keep {one_fewer}", fitted.dims());
+        // The floor holds even where fewer dimensions keep enough.
+        let floored = FitParams::new().variance(0.5).min_dims(5).check().unwrap().fit("circles", &segments).unwrap();
+        assert_eq!(floored.dims(), 5);
         // The basis is orthonormal.
         for (i, a) in fitted.basis().iter().enumerate() {
             for (j, b) in fitted.basis().iter().enumerate() {

@@ -6,16 +6,20 @@ use crate::vocab::knn::MAX_LATENT_DIMS;
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FitParams {
     /// Share of the poses' variance the latent space keeps.
-    pub(crate) variance: f64,
-    pub(crate) min_dims: usize,
-    pub(crate) max_dims: usize,
+    pub variance: f64,
+    /// At least this many dimensions, whatever the variance: a dimension
+    /// that opens a loop (the wrist turning while waving) can carry 2 or 3%
+    /// of the variance, and without it the way out and the way back fall
+    /// on one line where the field cancels out.
+    pub min_dims: usize,
+    pub max_dims: usize,
     /// Training poses consulted by the gradient field and progress.
-    pub(crate) neighbors: usize,
+    pub neighbors: usize,
 }
 
 impl Default for FitParams {
     fn default() -> Self {
-        FitParams { variance: 0.95, min_dims: 2, max_dims: 8, neighbors: 8 }
+        FitParams { variance: 0.95, min_dims: 4, max_dims: 8, neighbors: 8 }
     }
 }
 
@@ -94,7 +98,7 @@ mod tests {
         assert_eq!(FitParams::new().variance(0.0).check(), Err(FitParamsError::Variance(0.0)));
         assert_eq!(FitParams::new().min_dims(0).check(), Err(FitParamsError::MinDims));
         assert_eq!(FitParams::new().min_dims(4).max_dims(3).check(), Err(FitParamsError::MaxDims { min: 4, max: 3 }));
-        assert_eq!(FitParams::new().max_dims(13).check(), Err(FitParamsError::MaxDims { min: 2, max: 13 }));
+        assert_eq!(FitParams::new().max_dims(13).check(), Err(FitParamsError::MaxDims { min: 4, max: 13 }));
         assert_eq!(FitParams::new().neighbors(0).check(), Err(FitParamsError::Neighbors));
     }
 }

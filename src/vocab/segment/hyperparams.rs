@@ -15,22 +15,22 @@ pub enum Method {
 /// Segmentation settings; [`SegmentParams::check`] validates them.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SegmentParams {
-    pub(crate) method: Method,
-    pub(crate) min_length_s: f64,
-    pub(crate) max_length_s: f64,
-    pub(crate) smoothing_s: f64,
+    pub method: Method,
+    pub min_length_s: f64,
+    pub max_length_s: f64,
+    pub smoothing_s: f64,
     /// KCS: how close to its start the centroid must come back, as a share
     /// of its largest excursion.
-    pub(crate) return_share: f64,
+    pub return_share: f64,
     /// KCS: a return counts as retracing the way out, and the swing is cut
     /// at its turn, when it keeps closer than this share of its reach to
     /// the outward path (joint space).
-    pub(crate) retrace_share: f64,
+    pub retrace_share: f64,
     /// KCS: the smallest excursion that counts as a swing, meters.
-    pub(crate) min_excursion_m: f64,
+    pub min_excursion_m: f64,
     /// ZVC: how deep an energy dip must be, as a share of the lower of the
     /// peaks beside it.
-    pub(crate) dip_share: f64,
+    pub dip_share: f64,
 }
 
 impl Default for SegmentParams {

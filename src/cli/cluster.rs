@@ -1,0 +1,72 @@
+//! `imitate cluster`: group embedded segments into primitives.
+
+use super::learn::ClusterArgs;
+use super::{Global, Outcome, note};
+use anyhow::Context;
+use imitate::vocab::cluster::{Choice, ValidClusterParams};
+use imitate::vocab::evaluate::{activities_without_primitive, cluster_scores};
+use imitate::vocab::stages::{ClusterRecord, Clustered, Embedded};
+use std::path::PathBuf;
+
+/// Group embedded segments into primitives by k-means (linfa). Without
+/// `--k`, the number of primitives is the k with the highest mean
+/// silhouette, and the command says so.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// An embedding table from `imitate embed`.
+    pub embedding: PathBuf,
+    /// The clusters table to write (`.parquet` or `.csv`).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub cluster: ClusterArgs,
+}
+
+/// Clusters embedded segments and says how k was chosen and, where the
+/// segments are labelled, how well clusters match the labels.
+pub fn cluster(mut embedded: Embedded, params: &ValidClusterParams, global: Global) -> anyhow::Result<Clustered> {
+    let clustering = params.cluster(&embedded.embedding)?;
+    let score = clustering.score().unwrap_or(f64::NAN);
+    let how = match clustering.choice() {
+        Choice::Given => format!("k = {} as given (mean silhouette {score:.3})", clustering.k()),
+        Choice::Silhouette => {
+            let tried = clustering.scores();
+            let (low, high) = (tried.first().map_or(0, |s| s.0), tried.last().map_or(0, |s| s.0));
+            format!("k = {} chosen by the highest mean silhouette, {score:.3}, of k = {low} to {high}", clustering.k())
+        }
+    };
+    note(global, &format!("{} segments → {how}", embedded.embedding.len()));
+    let rows = &embedded.segments.rows;
+    if let Some(scores) = cluster_scores(rows, clustering.assignments()) {
+        let (all, whole) = (scores.all, scores.whole_activity);
+        note(
+            global,
+            &format!(
+                "against the labels: purity {:.3}, adjusted Rand index {:.3} over the {} segments of one activity; \
+                 {:.3} and {:.3} over all {}",
+                whole.purity,
+                whole.adjusted_rand_index,
+                whole.segments,
+                all.purity,
+                all.adjusted_rand_index,
+                all.segments
+            ),
+        );
+        let missing = activities_without_primitive(rows, clustering.assignments(), clustering.k());
+        if !missing.is_empty() {
+            note(global, &format!("no primitive of its own for: {}", missing.join(", ")));
+        }
+    }
+    embedded.segments.lineage.cluster = Some(ClusterRecord::new(params.params().clone(), &clustering));
+    Ok(Clustered { embedded, clustering })
+}
+
+pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
+    let params = args.cluster.params()?;
+    let context = || "`imitate cluster` reads an embedding table (from `imitate embed`)".to_string();
+    let embedded = Embedded::read(&args.embedding).with_context(context)?;
+    let clustered = cluster(embedded, &params, global)?;
+    clustered.write(&args.output)?;
+    note(global, &format!("wrote {}", args.output.display()));
+    Ok(Outcome::Success)
+}

@@ -1,0 +1,86 @@
+//! `imitate segment`: cut takes into segments.
+
+use super::learn::{RetargetArgs, SegmentArgs};
+use super::{Global, Outcome, note, progress};
+use imitate::vocab::corpus::{self, Corpus, read_labels};
+use imitate::vocab::pipeline::segment_corpus;
+use imitate::vocab::segment::ValidSegmentParams;
+use imitate::vocab::stages::{Lineage, RetargetSettings, Segments};
+use std::path::{Path, PathBuf};
+
+/// Cut BVH takes into segments (one row per segment: file, frames,
+/// duration, whether it is a whole cycle, label).
+///
+/// Writes a `segments` table, Parquet or CSV by the output's extension.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// BVH files, or folders whose `.bvh` files are all read.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// The segments table to write (`.parquet` or `.csv`).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Activity labels, used only to name and score: `file,activity` per
+    /// file, `frame,activity` per frame of one take (as `synth --sequence`
+    /// writes) or `file,frame,activity`.
+    #[arg(long, value_name = "LABELS.csv")]
+    pub labels: Option<PathBuf>,
+    #[command(flatten)]
+    pub retarget: RetargetArgs,
+    #[command(flatten)]
+    pub segment: SegmentArgs,
+}
+
+/// Reads and retargets the inputs, with their labels.
+pub fn load_corpus(
+    inputs: &[PathBuf],
+    labels: Option<&Path>,
+    retarget: &RetargetSettings,
+    global: Global,
+) -> anyhow::Result<Corpus> {
+    let labels = labels.map(|path| read_labels(path).map(|l| (l, path.display().to_string()))).transpose()?;
+    let bar = progress(global, 1, "read");
+    let corpus = corpus::load(inputs, &retarget.options()?, labels.as_ref().map(|(l, p)| (l, p.as_str())))?;
+    bar.finish_and_clear();
+    if let Some((_, path)) = &labels {
+        let unlabelled: Vec<&str> =
+            corpus.takes.iter().filter(|t| t.labels.is_none()).map(|t| t.path.as_str()).collect();
+        if !unlabelled.is_empty() {
+            note(global, &format!("{path}: warning: no labels for {}", unlabelled.join(", ")));
+        }
+    }
+    Ok(corpus)
+}
+
+/// Segments a corpus and says what came of it.
+pub fn segment(
+    corpus: &Corpus,
+    params: &ValidSegmentParams,
+    lineage: Lineage,
+    global: Global,
+) -> anyhow::Result<Segments> {
+    let rows = segment_corpus(corpus, params)?;
+    let segments = Segments::new(lineage, corpus, rows);
+    let cycles = segments.rows.iter().filter(|r| r.phase_offset.is_some()).count();
+    let seconds: f64 = corpus.takes.iter().map(|t| t.motion.poses.len() as f64 * t.motion.frame_time_s).sum();
+    note(
+        global,
+        &format!(
+            "{} takes ({} frames, {seconds:.1} s) → {} segments ({cycles} whole cycles)",
+            corpus.takes.len(),
+            corpus.frames(),
+            segments.rows.len()
+        ),
+    );
+    Ok(segments)
+}
+
+pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
+    let params = args.segment.params()?;
+    let settings = args.retarget.settings();
+    let corpus = load_corpus(&args.inputs, args.labels.as_deref(), &settings, global)?;
+    let segments = segment(&corpus, &params, Lineage::new(settings, params.params().clone()), global)?;
+    segments.write(&args.output)?;
+    note(global, &format!("wrote {}", args.output.display()));
+    Ok(Outcome::Success)
+}

@@ -1,0 +1,231 @@
+//! `imitate vocab build` (every learning stage in one go) and `imitate
+//! vocab info`.
+
+use super::learn::{ClusterArgs, EmbedArgs, FitArgs, RetargetArgs, SegmentArgs};
+use super::{Global, Outcome, note, write_stdout};
+use imitate::vocab::container::FORMAT_VERSION;
+use imitate::vocab::stages::Lineage;
+use imitate::vocab::vocabulary::Vocabulary;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// Build and look at vocabularies.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, clap::Subcommand)]
+pub enum Command {
+    Build(Box<BuildArgs>),
+    Info(InfoArgs),
+}
+
+/// Learn a vocabulary from BVH takes: segment, embed, cluster, fit and
+/// export in one go (each stage's settings as in its own subcommand), and
+/// print how long each stage took.
+#[derive(Debug, clap::Args)]
+pub struct BuildArgs {
+    /// BVH files, or folders whose `.bvh` files are all read.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// The vocabulary file to write, e.g. `vocab/NAME.vocab`.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Activity labels, used only to name primitives and to score the
+    /// clustering (formats as for `imitate segment`).
+    #[arg(long, value_name = "LABELS.csv")]
+    pub labels: Option<PathBuf>,
+    #[command(flatten)]
+    pub retarget: RetargetArgs,
+    #[command(flatten)]
+    pub segment: SegmentArgs,
+    #[command(flatten)]
+    pub embed: EmbedArgs,
+    #[command(flatten)]
+    pub cluster: ClusterArgs,
+    #[command(flatten)]
+    pub fit: FitArgs,
+}
+
+/// Print a vocabulary's primitives: dimensions, variance kept, training
+/// frames and sources, and how it was built.
+#[derive(Debug, clap::Args)]
+pub struct InfoArgs {
+    /// A `.vocab` file.
+    pub file: PathBuf,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
+    match args.command {
+        Command::Build(args) => build(*args, global),
+        Command::Info(args) => info(args),
+    }
+}
+
+/// A spinner for one stage on stderr, finished with the stage's time.
+struct Stage {
+    bar: ProgressBar,
+    name: &'static str,
+    started: Instant,
+}
+
+impl Stage {
+    fn start(global: Global, name: &'static str) -> Stage {
+        let bar = if global.quiet || !std::io::stderr().is_terminal() {
+            ProgressBar::hidden()
+        } else {
+            let bar = ProgressBar::new_spinner().with_message(name);
+            bar.set_style(
+                ProgressStyle::with_template("{spinner} {msg:<8} {elapsed_precise}").expect("valid template"),
+            );
+            bar.enable_steady_tick(Duration::from_millis(100));
+            bar
+        };
+        Stage { bar, name, started: Instant::now() }
+    }
+
+    fn finish(self) -> (&'static str, f64) {
+        let seconds = self.started.elapsed().as_secs_f64();
+        self.bar.finish_and_clear();
+        (self.name, seconds)
+    }
+}
+
+fn build(args: BuildArgs, global: Global) -> anyhow::Result<Outcome> {
+    let (segment_params, embed_params) = (args.segment.params()?, args.embed.params()?);
+    let (cluster_params, fit_params) = (args.cluster.params()?, args.fit.params()?);
+    let settings = args.retarget.settings();
+    let mut times = Vec::new();
+
+    let stage = Stage::start(global, "read");
+    let corpus = super::segment::load_corpus(&args.inputs, args.labels.as_deref(), &settings, global)?;
+    times.push(stage.finish());
+    let stage = Stage::start(global, "segment");
+    let lineage = Lineage::new(settings, segment_params.params().clone());
+    let segments = super::segment::segment(&corpus, &segment_params, lineage, global)?;
+    times.push(stage.finish());
+    let stage = Stage::start(global, "embed");
+    let embedded = super::embed::embed(&corpus, segments, &embed_params, global)?;
+    times.push(stage.finish());
+    let stage = Stage::start(global, "cluster");
+    let clustered = super::cluster::cluster(embedded, &cluster_params, global)?;
+    times.push(stage.finish());
+    let stage = Stage::start(global, "fit");
+    let mut vocabulary = super::fit::fit(&corpus, &clustered, &fit_params, global)?;
+    times.push(stage.finish());
+    let stage = Stage::start(global, "write");
+    vocabulary.save(&args.output)?;
+    times.push(stage.finish());
+
+    note(global, &saved(&vocabulary, &args.output));
+    let total: f64 = times.iter().map(|t| t.1).sum();
+    let each: Vec<String> = times.iter().map(|(name, s)| format!("{name} {s:.2} s")).collect();
+    note(global, &format!("time: {}; total {total:.2} s for {} frames", each.join(", "), corpus.frames()));
+    Ok(Outcome::Success)
+}
+
+/// The line saying a vocabulary was written.
+pub fn saved(vocabulary: &Vocabulary, path: &Path) -> String {
+    let bytes = std::fs::metadata(path).map_or(0, |m| m.len());
+    format!(
+        "wrote {}: {} primitives, {:.1} KB, CRC-32 {:#010x}",
+        path.display(),
+        vocabulary.primitives().len(),
+        bytes as f64 / 1024.0,
+        vocabulary.checksum().unwrap_or(0)
+    )
+}
+
+fn info(args: InfoArgs) -> anyhow::Result<Outcome> {
+    let vocabulary = Vocabulary::load(&args.file)?;
+    let bytes = std::fs::metadata(&args.file).map_or(0, |m| m.len());
+    let checksum = format!("{:#010x}", vocabulary.checksum().unwrap_or(0));
+    let (header, _) = vocabulary.to_parts();
+    let text = if args.json {
+        let mut value = serde_json::to_value(&header).expect("the header serializes");
+        let object = value.as_object_mut().expect("the header is an object");
+        object.insert("file".into(), args.file.display().to_string().into());
+        object.insert("format_version".into(), FORMAT_VERSION.into());
+        object.insert("bytes".into(), bytes.into());
+        object.insert("checksum".into(), checksum.into());
+        serde_json::to_string_pretty(&value).expect("JSON serializes") + "\n"
+    } else {
+        describe(&vocabulary, &args.file, bytes, &checksum)
+    };
+    write_stdout(&text)?;
+    Ok(Outcome::Success)
+}
+
+/// `vocab info` as text.
+fn describe(vocabulary: &Vocabulary, path: &Path, bytes: u64, checksum: &str) -> String {
+    let b = vocabulary.build_info();
+    let l = &b.lineage;
+    let mut out = vec![
+        format!(
+            "{}: imitate vocabulary, format {FORMAT_VERSION}, {:.1} KB, CRC-32 {checksum}",
+            path.display(),
+            bytes as f64 / 1024.0
+        ),
+        format!(
+            "built by imitate {} from {} takes ({} frames, {} segments)",
+            l.imitate,
+            b.takes.len(),
+            b.frames,
+            b.segments
+        ),
+    ];
+    let s = &l.segment;
+    out.push(format!("  segment: {:?}, {}–{} s", s.method, s.min_length_s, s.max_length_s).to_lowercase());
+    if let Some(e) = &l.embed {
+        let kind = if e.temporal {
+            format!("ST-Isomap (c_atn {}, c_ctn {})", e.c_atn, e.c_ctn)
+        } else {
+            "plain Isomap".to_string()
+        };
+        out.push(format!(
+            "  embed:   {kind}, {} neighbours, {} dimensions, {} poses per segment",
+            e.neighbors, e.dims, e.resample
+        ));
+    }
+    if let Some(c) = &l.cluster {
+        let k = vocabulary.primitives().len() + b.still.len();
+        let chosen = c.silhouettes.iter().find(|(n, _)| *n == k).map_or(f64::NAN, |s| s.1);
+        out.push(
+            format!("  cluster: k = {k} ({:?}; mean silhouette {chosen:.3}), seed {}", c.choice, c.params.seed)
+                .to_lowercase(),
+        );
+    }
+    let f = &b.fit;
+    out.push(format!(
+        "  fit:     {:.0}% of variance, {}–{} dimensions, {} field neighbours",
+        100.0 * f.variance,
+        f.min_dims,
+        f.max_dims,
+        f.neighbors
+    ));
+    if !b.still.is_empty() {
+        out.push(format!("  left out (no motion): {}", b.still.join(", ")));
+    }
+    out.push(String::new());
+    out.push(super::fit::summary(vocabulary));
+    out.push(String::new());
+    for p in vocabulary.primitives() {
+        let mut files: Vec<(&str, usize)> = Vec::new();
+        for s in p.sources() {
+            match files.iter_mut().find(|(f, _)| *f == s.file) {
+                Some(entry) => entry.1 += 1,
+                None => files.push((&s.file, 1)),
+            }
+        }
+        let listed: Vec<String> = files.iter().map(|(f, n)| format!("{f} ×{n}")).collect();
+        out.push(format!("{}: {}", p.name(), listed.join(", ")));
+    }
+    out.join("\n") + "\n"
+}
