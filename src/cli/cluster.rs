@@ -3,7 +3,7 @@
 use super::learn::ClusterArgs;
 use super::{Global, Outcome, note};
 use anyhow::Context;
-use imitate::vocab::cluster::{Choice, ValidClusterParams};
+use imitate::vocab::cluster::{Choice, ValidClusterParams, best};
 use imitate::vocab::evaluate::{activities_without_primitive, cluster_scores};
 use imitate::vocab::stages::{ClusterRecord, Clustered, Embedded};
 use std::path::PathBuf;
@@ -31,8 +31,21 @@ pub fn cluster(mut embedded: Embedded, params: &ValidClusterParams, global: Glob
         Choice::Given => format!("k = {} as given (mean silhouette {score:.3})", clustering.k()),
         Choice::Silhouette => {
             let tried = clustering.scores();
-            let (low, high) = (tried.first().map_or(0, |s| s.0), tried.last().map_or(0, |s| s.0));
-            format!("k = {} chosen by the highest mean silhouette, {score:.3}, of k = {low} to {high}", clustering.k())
+            let (low, high) = (tried.first().map_or(0, |t| t.k), tried.last().map_or(0, |t| t.k));
+            let p = params.params();
+            let why = match best(tried, p.min_size) {
+                Some(b) if b.k != clustering.k() => format!(
+                    "within {} standard error of the best ({:.3} ± {:.3} at k = {}), the largest k",
+                    p.tolerance, b.silhouette, b.standard_error, b.k
+                ),
+                _ => "the best".to_string(),
+            };
+            let sized = if p.min_size > 1 {
+                format!(" with clusters of {} or more segments", p.min_size)
+            } else {
+                String::new()
+            };
+            format!("k = {} chosen by mean silhouette {score:.3}, {why} of k = {low} to {high}{sized}", clustering.k())
         }
     };
     note(global, &format!("{} segments → {how}", embedded.embedding.len()));

@@ -2,7 +2,7 @@
 //! canonical body.
 
 use super::retarget::{UpArg, options};
-use super::{Global, Outcome, write_stdout};
+use super::{Global, Outcome, peak_resident_mb, write_stdout};
 use imitate::mocap::bvh::{Bvh, Channel, Warning, read_bvh};
 use imitate::mocap::retarget::{Analysis, RetargetOptions, Retargeter};
 use serde::Serialize;
@@ -182,14 +182,6 @@ fn describe(bvh: &Bvh) -> Contents {
         analysis: None,
         standing_height_m: None,
     }
-}
-
-/// The process's peak resident set size (Linux `VmHWM`), MB.
-fn peak_resident_mb() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024.0 / 1e6)
 }
 
 /// The text form of one report.

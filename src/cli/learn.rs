@@ -168,6 +168,10 @@ pub struct ClusterArgs {
     /// least this many segments.
     #[arg(long, value_name = "N", default_value_t = ClusterParams::default().min_size)]
     pub min_size: usize,
+    /// When choosing k, mean silhouettes within this many standard errors
+    /// of the best count as equal, and the largest such k is chosen.
+    #[arg(long, value_name = "STANDARD_ERRORS", default_value_t = ClusterParams::default().tolerance)]
+    pub tolerance: f64,
     /// Seed of k-means' initial centroids.
     #[arg(long, default_value_t = ClusterParams::default().seed)]
     pub seed: u64,
@@ -175,9 +179,16 @@ pub struct ClusterArgs {
 
 impl ClusterArgs {
     pub fn params(&self) -> Result<ValidClusterParams, UsageError> {
-        ClusterParams { k: self.k, max_k: self.max_k, runs: self.runs, min_size: self.min_size, seed: self.seed }
-            .check()
-            .map_err(|e| UsageError(e.to_string()))
+        ClusterParams {
+            k: self.k,
+            max_k: self.max_k,
+            runs: self.runs,
+            min_size: self.min_size,
+            tolerance: self.tolerance,
+            seed: self.seed,
+        }
+        .check()
+        .map_err(|e| UsageError(e.to_string()))
     }
 }
 

@@ -2,7 +2,7 @@
 //! vocab info`.
 
 use super::learn::{ClusterArgs, EmbedArgs, FitArgs, RetargetArgs, SegmentArgs};
-use super::{Global, Outcome, note, write_stdout};
+use super::{Global, Outcome, note, peak_resident_mb, write_stdout};
 use imitate::vocab::container::FORMAT_VERSION;
 use imitate::vocab::stages::Lineage;
 use imitate::vocab::vocabulary::Vocabulary;
@@ -127,7 +127,8 @@ fn build(args: BuildArgs, global: Global) -> anyhow::Result<Outcome> {
     note(global, &saved(&vocabulary, &args.output));
     let total: f64 = times.iter().map(|t| t.1).sum();
     let each: Vec<String> = times.iter().map(|(name, s)| format!("{name} {s:.2} s")).collect();
-    note(global, &format!("time: {}; total {total:.2} s for {} frames", each.join(", "), corpus.frames()));
+    let memory = peak_resident_mb().map_or(String::new(), |mb| format!("; peak memory {mb:.0} MB"));
+    note(global, &format!("time: {}; total {total:.2} s for {} frames{memory}", each.join(", "), corpus.frames()));
     Ok(Outcome::Success)
 }
 
@@ -196,7 +197,7 @@ fn describe(vocabulary: &Vocabulary, path: &Path, bytes: u64, checksum: &str) ->
     }
     if let Some(c) = &l.cluster {
         let k = vocabulary.primitives().len() + b.still.len();
-        let chosen = c.silhouettes.iter().find(|(n, _)| *n == k).map_or(f64::NAN, |s| s.1);
+        let chosen = c.tried.iter().find(|t| t.k == k).map_or(f64::NAN, |t| t.silhouette);
         out.push(
             format!("  cluster: k = {k} ({:?}; mean silhouette {chosen:.3}), seed {}", c.choice, c.params.seed)
                 .to_lowercase(),

@@ -6,6 +6,7 @@
 
 use crate::mocap::body::DOF;
 use crate::mocap::pose::Motion;
+use crate::mocap::synth::{Activity, SynthOptions, sequence_take};
 use crate::vocab::corpus::Corpus;
 use crate::vocab::metrics::{adjusted_rand_index, cosine, majority_labels, purity, spearman};
 use crate::vocab::phase::{ArcPath, PhaseAxes};
@@ -21,6 +22,31 @@ use std::collections::BTreeSet;
 /// frames carry that activity's label. Segments that straddle a change of
 /// activity are transitions: no label is right for them.
 pub const WHOLE_ACTIVITY_SHARE: f64 = 0.9;
+
+/// The benchmark stream: circles, horizontal and vertical waving
+/// and punching chained, 4 repetitions each, one take per (seed, speed),
+/// labelled per frame (for scoring only). Learning uses seeds `10s`,
+/// `10s + 1`, `10s + 2` at 0.5×, 1× and 2×; [`held_out_stream`] the same
+/// activities from other seeds at other speeds.
+pub fn benchmark_stream(seed: u64) -> Corpus {
+    stream([10 * seed, 10 * seed + 1, 10 * seed + 2], [0.5, 1.0, 2.0])
+}
+
+/// Repetitions learning never saw: seeds `10s + 100` to `10s + 102` at
+/// 0.75×, 1× and 1.5×.
+pub fn held_out_stream(seed: u64) -> Corpus {
+    stream([10 * seed + 100, 10 * seed + 101, 10 * seed + 102], [0.75, 1.0, 1.5])
+}
+
+fn stream(seeds: [u64; 3], speeds: [f64; 3]) -> Corpus {
+    let activities = [Activity::Circles, Activity::WaveH, Activity::WaveV, Activity::Punch];
+    let mut corpus = Corpus::default();
+    for (seed, speed) in seeds.into_iter().zip(speeds) {
+        let take = sequence_take(&activities, &SynthOptions { speed, repetitions: 4, seed, ..Default::default() });
+        corpus.push(format!("stream-{seed}.bvh"), take.motion, Some(&take.labels));
+    }
+    corpus
+}
 
 /// Agreement of a clustering with labels over a set of segments.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -231,7 +257,7 @@ pub fn check_held_out(
     let fitted = &build.fitted;
     // The primitive fitted to each training segment's cluster, if any.
     let primitive_of: Vec<Option<usize>> =
-        build.clustering.assignments().iter().map(|c| fitted.clusters.iter().position(|fc| fc == c)).collect();
+        (0..build.segments.len()).map(|i| fitted.members.iter().position(|m| m.contains(&i))).collect();
     let activity_of = |p: usize| {
         let name = fitted.primitives[p].name();
         name.rsplit_once('-').filter(|(_, n)| n.parse::<u32>().is_ok()).map_or(name, |(a, _)| a)
@@ -276,9 +302,9 @@ fn joint_fields(build: &Build, corpus: &Corpus, fit: &ValidFitParams) -> Result<
     fitted
         .primitives
         .par_iter()
-        .zip(&fitted.clusters)
-        .map(|(primitive, &c)| {
-            let segments = training_segments(corpus, &build.segments, build.clustering.assignments(), c);
+        .zip(&fitted.members)
+        .map(|(primitive, members)| {
+            let segments = training_segments(corpus, &build.segments, members);
             fit.joint_field(primitive.name(), &segments)
         })
         .collect()

@@ -1,6 +1,7 @@
 //! The stages chained in memory: what `imitate vocab build` runs, and what
 //! each stage's subcommand runs one step of.
 
+use crate::mocap::body::DOF;
 use crate::vocab::cluster::{ClusterError, Clustering, ValidClusterParams};
 use crate::vocab::corpus::Corpus;
 use crate::vocab::embed::{EmbedError, Embedding, ValidEmbedParams, resample};
@@ -112,17 +113,18 @@ pub fn embed_segments(
 }
 
 /// Primitive names: each cluster's majority label (held by more than half
-/// its labelled segments; a repeated label gets `-2`, `-3`, …), else
-/// `p<i>` for cluster `i`.
+/// its labelled segments), else `p<i>` for cluster `i`; not yet unique.
 pub fn primitive_names(rows: &[SegmentRow], clustering: &Clustering) -> Vec<String> {
     let labels: Vec<Option<&str>> = rows.iter().map(|r| r.label.as_deref()).collect();
     let majorities = majority_labels(clustering.assignments(), &labels, clustering.k());
+    majorities.iter().enumerate().map(|(i, m)| m.map_or_else(|| format!("p{i}"), str::to_string)).collect()
+}
+
+/// Names made unique: a repeated name gets `-2`, `-3`, ….
+fn unique_names(names: impl Iterator<Item = String>) -> Vec<String> {
     let mut used = std::collections::BTreeMap::<String, usize>::new();
-    majorities
-        .iter()
-        .enumerate()
-        .map(|(i, m)| {
-            let base = m.map_or_else(|| format!("p{i}"), str::to_string);
+    names
+        .map(|base| {
             let count = used.entry(base.clone()).or_insert(0);
             *count += 1;
             if *count == 1 { base } else { format!("{base}-{count}") }
@@ -130,55 +132,110 @@ pub fn primitive_names(rows: &[SegmentRow], clustering: &Clustering) -> Vec<Stri
         .collect()
 }
 
-/// The segments of cluster `c`, as training motion.
+/// Segments `members` (indices into `rows`), as training motion.
 pub fn training_segments<'a>(
     corpus: &'a Corpus,
     rows: &'a [SegmentRow],
-    assignments: &[usize],
-    c: usize,
+    members: &[usize],
 ) -> Vec<TrainingSegment<'a>> {
-    rows.iter()
-        .zip(assignments)
-        .filter(|(_, a)| **a == c)
-        .map(|(r, _)| TrainingSegment {
-            motion: &corpus.takes[r.take].motion,
-            span: r.span,
-            phase_offset: r.phase_offset,
-            file: &corpus.takes[r.take].path,
-            label: r.label.as_deref(),
+    members
+        .iter()
+        .map(|&i| {
+            let r = &rows[i];
+            TrainingSegment {
+                motion: &corpus.takes[r.take].motion,
+                span: r.span,
+                phase_offset: r.phase_offset,
+                file: &corpus.takes[r.take].path,
+                label: r.label.as_deref(),
+            }
         })
         .collect()
+}
+
+/// Poses along each swing for [`direction_groups`].
+const DIRECTION_SAMPLES: usize = 16;
+/// Rounds of [`direction_groups`]' orientation.
+const DIRECTION_ROUNDS: usize = 5;
+/// A swing counts as going the other way when its path reversed is closer
+/// to the common path than this share of its path as it is.
+const REVERSED_SHARE: f64 = 0.5;
+
+/// Splits a cluster's segments (`members`) by the way they travel: swings
+/// (segments that are not whole cycles) that follow the cluster's common
+/// path backwards, like the way back of a reach clustered with the way
+/// out, form a second group. A pose-only gradient field cannot hold both
+/// directions of one path (they cancel), so each group becomes a primitive
+/// of its own. Each swing's path is oriented to agree with the mean of the
+/// oriented paths, over a few rounds; a second group needs two swings.
+fn direction_groups(corpus: &Corpus, rows: &[SegmentRow], members: &[usize]) -> Vec<Vec<usize>> {
+    let swings: Vec<usize> = members.iter().copied().filter(|&i| rows[i].phase_offset.is_none()).collect();
+    let paths: Vec<Vec<f64>> = swings
+        .iter()
+        .map(|&i| resample(&corpus.takes[rows[i].take].motion, rows[i].span, DIRECTION_SAMPLES, None))
+        .collect();
+    let reversed = |path: &[f64]| -> Vec<f64> { path.chunks_exact(DOF).rev().flatten().copied().collect() };
+    let distance = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt();
+    let mut backwards = vec![false; paths.len()];
+    // Start from the first swing's path: the mean of a path and its
+    // reverse runs both ways at once and would orient nothing.
+    let Some(mut mean) = paths.first().cloned() else { return vec![members.to_vec()] };
+    for _ in 0..DIRECTION_ROUNDS {
+        for (path, back) in paths.iter().zip(backwards.iter_mut()) {
+            *back = distance(&reversed(path), &mean) < REVERSED_SHARE * distance(path, &mean);
+        }
+        mean.fill(0.0);
+        for (path, &back) in paths.iter().zip(&backwards) {
+            let oriented = if back { reversed(path) } else { path.clone() };
+            mean.iter_mut().zip(&oriented).for_each(|(m, x)| *m += x / paths.len() as f64);
+        }
+    }
+    let back: Vec<usize> = swings.iter().zip(&backwards).filter(|(_, b)| **b).map(|(i, _)| *i).collect();
+    let forward: Vec<usize> = members.iter().copied().filter(|i| !back.contains(i)).collect();
+    let forward_swings = forward.iter().filter(|&&i| rows[i].phase_offset.is_none()).count();
+    if back.len() >= 2 && forward_swings >= 2 { vec![forward, back] } else { vec![members.to_vec()] }
 }
 
 /// The primitives fitted to a clustering.
 pub struct Fitted {
     /// In cluster order, without the clusters of still segments.
     pub primitives: Vec<Primitive>,
-    /// The cluster each primitive was fitted to.
-    pub clusters: Vec<usize>,
+    /// The segments (indices into the rows) each primitive was fitted to.
+    pub members: Vec<Vec<usize>>,
     /// Names of clusters left out because their poses never change: with
     /// no motion there is no gradient field to learn.
     pub still: Vec<String>,
 }
 
-/// Fits one primitive per cluster (in parallel), in cluster order.
+/// Fits a primitive to each cluster (in parallel), in cluster order; a
+/// cluster whose swings travel one path both ways gives one primitive per
+/// direction ([`direction_groups`]), the second named like a repeat.
 pub fn fit_primitives(
     corpus: &Corpus,
     rows: &[SegmentRow],
     clustering: &Clustering,
     params: &ValidFitParams,
 ) -> Result<Fitted, BuildError> {
-    let names = primitive_names(rows, clustering);
-    let results: Vec<Result<Primitive, FitError>> = (0..clustering.k())
+    let cluster_names = primitive_names(rows, clustering);
+    let groups: Vec<(usize, Vec<usize>)> = (0..clustering.k())
         .into_par_iter()
-        .map(|c| params.fit(&names[c], &training_segments(corpus, rows, clustering.assignments(), c)))
+        .flat_map_iter(|c| {
+            let members: Vec<usize> = (0..rows.len()).filter(|&i| clustering.assignments()[i] == c).collect();
+            direction_groups(corpus, rows, &members).into_iter().map(move |g| (c, g))
+        })
         .collect();
-    let mut fitted = Fitted { primitives: Vec::new(), clusters: Vec::new(), still: Vec::new() };
-    for (c, result) in results.into_iter().enumerate() {
+    let names = unique_names(groups.iter().map(|(c, _)| cluster_names[*c].clone()));
+    let results: Vec<Result<Primitive, FitError>> = groups
+        .par_iter()
+        .zip(&names)
+        .map(|((_, members), name)| params.fit(name, &training_segments(corpus, rows, members)))
+        .collect();
+    let mut fitted = Fitted { primitives: Vec::new(), members: Vec::new(), still: Vec::new() };
+    for ((_, members), result) in groups.into_iter().zip(results) {
         match result {
             Ok(primitive) => {
                 fitted.primitives.push(primitive);
-                fitted.clusters.push(c);
+                fitted.members.push(members);
             }
             Err(FitError::Motionless(name)) => fitted.still.push(name),
             Err(other) => return Err(other.into()),

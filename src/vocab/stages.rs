@@ -17,7 +17,7 @@
 use crate::mocap::body::{DOF, Joint, Kind};
 use crate::mocap::names::{MappingError, UserMapping};
 use crate::mocap::retarget::{RetargetOptions, UpAxis};
-use crate::vocab::cluster::{Choice, ClusterParams, Clustering};
+use crate::vocab::cluster::{Choice, ClusterParams, Clustering, Tried};
 use crate::vocab::corpus::{self, Corpus, CorpusError};
 use crate::vocab::embed::{EmbedParams, Embedding};
 use crate::vocab::pipeline::SegmentRow;
@@ -76,13 +76,13 @@ impl RetargetSettings {
 pub struct ClusterRecord {
     pub params: ClusterParams,
     pub choice: Choice,
-    /// Mean silhouette of each k tried.
-    pub silhouettes: Vec<(usize, f64)>,
+    /// Each k tried: mean silhouette and smallest cluster.
+    pub tried: Vec<Tried>,
 }
 
 impl ClusterRecord {
     pub fn new(params: ClusterParams, clustering: &Clustering) -> ClusterRecord {
-        ClusterRecord { params, choice: clustering.choice().clone(), silhouettes: clustering.scores().to_vec() }
+        ClusterRecord { params, choice: clustering.choice().clone(), tried: clustering.scores().to_vec() }
     }
 }
 
@@ -373,7 +373,7 @@ impl Clustered {
                 problem: format!("clusters are numbered 0 to {} but cluster {empty} has no segment", k - 1),
             });
         }
-        let clustering = Clustering::recorded(assignments, record.choice, record.silhouettes);
+        let clustering = Clustering::recorded(assignments, record.choice, record.tried);
         Ok(Clustered { embedded: Embedded::from_table(segments, &table, path)?, clustering })
     }
 }

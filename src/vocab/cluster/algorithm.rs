@@ -27,13 +27,27 @@ pub struct Clustering {
     assignments: Vec<usize>,
     k: usize,
     choice: Choice,
-    /// Mean silhouette for every k tried (for `--k`, only that one).
-    scores: Vec<(usize, f64)>,
+    /// Every k tried (for `--k`, only that one).
+    scores: Vec<Tried>,
+}
+
+/// One k tried, and how it scored.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Tried {
+    pub k: usize,
+    /// Mean silhouette.
+    pub silhouette: f64,
+    /// Its standard error (the spread of the points' silhouettes over the
+    /// square root of their number).
+    #[serde(default)]
+    pub standard_error: f64,
+    /// Segments in its smallest cluster.
+    pub smallest: usize,
 }
 
 impl Clustering {
     /// A clustering read back from a table, with how its k was chosen.
-    pub fn recorded(assignments: Vec<usize>, choice: Choice, scores: Vec<(usize, f64)>) -> Clustering {
+    pub fn recorded(assignments: Vec<usize>, choice: Choice, scores: Vec<Tried>) -> Clustering {
         let k = assignments.iter().max().map_or(0, |m| m + 1);
         Clustering { assignments, k, choice, scores }
     }
@@ -50,13 +64,13 @@ impl Clustering {
         &self.choice
     }
 
-    pub fn scores(&self) -> &[(usize, f64)] {
+    pub fn scores(&self) -> &[Tried] {
         &self.scores
     }
 
     /// The mean silhouette of the chosen k.
     pub fn score(&self) -> Option<f64> {
-        self.scores.iter().find(|(k, _)| *k == self.k).map(|(_, s)| *s)
+        self.scores.iter().find(|t| t.k == self.k).map(|t| t.silhouette)
     }
 }
 
@@ -83,32 +97,23 @@ impl ValidClusterParams {
                     return Err(ClusterError::TooManyClusters { k, segments: n });
                 }
                 let a = self.kmeans(&records, k)?;
-                let score = silhouette(&records, &a);
-                (a, Choice::Given, vec![(k, score)])
+                let tried = score(&records, &a, k);
+                (a, Choice::Given, vec![tried])
             }
             None => {
                 if n < 3 {
                     return Err(ClusterError::TooFewSegments(n));
                 }
-                // The best of all, and the best with clusters of min_size.
-                let mut best: [Option<(f64, Vec<usize>)>; 2] = [None, None];
-                let mut scores = Vec::new();
-                for k in 2..=p.max_k.min(n - 1) {
-                    let a = self.kmeans(&records, k)?;
-                    let score = silhouette(&records, &a);
-                    scores.push((k, score));
-                    let mut sizes = vec![0; k];
-                    a.iter().for_each(|&c| sizes[c] += 1);
-                    let sized = sizes.iter().all(|&s| s >= p.min_size);
-                    for (slot, eligible) in best.iter_mut().zip([true, sized]) {
-                        // Strictly better only: ties keep the fewer primitives.
-                        if eligible && slot.as_ref().is_none_or(|(s, _)| score > *s) {
-                            *slot = Some((score, a.clone()));
-                        }
-                    }
-                }
-                let [any, sized] = best;
-                let (_, a) = sized.or(any).expect("k = 2 is always tried");
+                let tried = (2..=p.max_k.min(n - 1))
+                    .into_par_iter()
+                    .map(|k| {
+                        let a = self.kmeans(&records, k)?;
+                        Ok((score(&records, &a, k), a))
+                    })
+                    .collect::<Result<Vec<_>, ClusterError>>()?;
+                let scores: Vec<Tried> = tried.iter().map(|t| t.0).collect();
+                let chosen = choose_k(&scores, p.min_size, p.tolerance);
+                let a = tried.into_iter().find(|t| t.0.k == chosen).expect("chosen among the tried").1;
                 (a, Choice::Silhouette, scores)
             }
         };
@@ -131,6 +136,37 @@ impl ValidClusterParams {
     }
 }
 
+/// How the `k` clusters of `assignments` score.
+fn score(records: &Array2<f64>, assignments: &[usize], k: usize) -> Tried {
+    let mut sizes = vec![0; k];
+    assignments.iter().for_each(|&c| sizes[c] += 1);
+    let (silhouette, standard_error) = silhouette(records, assignments);
+    Tried { k, silhouette, standard_error, smallest: sizes.into_iter().min().unwrap_or(0) }
+}
+
+/// The clusterings that compete when k is chosen: those whose clusters all
+/// hold at least `min_size` segments, or all of them if none do.
+pub fn eligible(tried: &[Tried], min_size: usize) -> impl Iterator<Item = &Tried> {
+    let any_sized = tried.iter().any(|t| t.smallest >= min_size);
+    tried.iter().filter(move |t| t.smallest >= min_size || !any_sized)
+}
+
+/// The eligible clustering with the best mean silhouette.
+pub fn best(tried: &[Tried], min_size: usize) -> Option<&Tried> {
+    eligible(tried, min_size).fold(None, |best: Option<&Tried>, t| match best {
+        Some(b) if b.silhouette >= t.silhouette => Some(b),
+        _ => Some(t),
+    })
+}
+
+/// Among the eligible clusterings, the largest k whose mean silhouette is
+/// within `tolerance` standard errors of the best (statistically as good).
+fn choose_k(tried: &[Tried], min_size: usize, tolerance: f64) -> usize {
+    let best = best(tried, min_size).expect("k = 2 is tried");
+    let floor = best.silhouette - tolerance * best.standard_error;
+    eligible(tried, min_size).filter(|t| t.silhouette >= floor).map(|t| t.k).max().unwrap_or(best.k)
+}
+
 /// Points beyond which the silhouette is estimated on an evenly spread
 /// sample of this many (it costs a pass over all pairs).
 const SILHOUETTE_SAMPLE: usize = 2000;
@@ -141,11 +177,12 @@ const SILHOUETTE_SAMPLE: usize = 2000;
 /// scores 0, as Rousseeuw defines it. (linfa scores it 1, which rewards
 /// splitting points off into clusters of their own: we choose k with this
 /// one.)
-fn silhouette(records: &Array2<f64>, assignments: &[usize]) -> f64 {
+/// Returns the mean and its standard error.
+fn silhouette(records: &Array2<f64>, assignments: &[usize]) -> (f64, f64) {
     let n = assignments.len();
     let k = assignments.iter().max().map_or(0, |m| m + 1);
     if k < 2 {
-        return 0.0;
+        return (0.0, 0.0);
     }
     let mut sizes = vec![0usize; k];
     for &a in assignments {
@@ -174,7 +211,10 @@ fn silhouette(records: &Array2<f64>, assignments: &[usize]) -> f64 {
             if a.max(b) > 0.0 { (b - a) / a.max(b) } else { 0.0 }
         })
         .collect();
-    scores.iter().sum::<f64>() / scores.len() as f64
+    let m = scores.len() as f64;
+    let mean = scores.iter().sum::<f64>() / m;
+    let variance = scores.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (m - 1.0).max(1.0);
+    (mean, (variance / m).sqrt())
 }
 
 /// Renumbers clusters in order of their first member, so numbering (and
@@ -212,7 +252,7 @@ mod tests {
         assert_eq!(c.k(), 3);
         assert_eq!(c.choice(), &Choice::Silhouette);
         let best = c.score().unwrap();
-        assert!(best > 0.9 && c.scores().iter().all(|(_, s)| *s <= best), "{:?}", c.scores());
+        assert!(best > 0.9 && c.scores().iter().all(|t| t.silhouette <= best), "{:?}", c.scores());
         // Numbered by first appearance: segment 0 is in primitive 0.
         assert_eq!(&c.assignments()[..3], &[0, 1, 2]);
     }

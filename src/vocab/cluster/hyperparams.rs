@@ -14,17 +14,35 @@ pub struct ClusterParams {
     /// nothing to generalize from); if none does, all do.
     #[serde(default = "default_min_size")]
     pub min_size: usize,
+    /// When choosing k, mean silhouettes within this many standard errors
+    /// of the best count as equally good, and the largest such k wins: two
+    /// primitives for one activity cost little (both carry its name, and
+    /// each still models it), while one primitive for two activities mixes
+    /// their fields.
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
     pub seed: u64,
 }
 
 impl Default for ClusterParams {
     fn default() -> Self {
-        ClusterParams { k: None, max_k: 24, runs: 10, min_size: default_min_size(), seed: 1 }
+        ClusterParams {
+            k: None,
+            max_k: 24,
+            runs: 10,
+            min_size: default_min_size(),
+            tolerance: default_tolerance(),
+            seed: 1,
+        }
     }
 }
 
 fn default_min_size() -> usize {
     2
+}
+
+fn default_tolerance() -> f64 {
+    1.0
 }
 
 /// Settings that passed [`ClusterParams::check`].
@@ -39,6 +57,8 @@ pub enum ClusterParamsError {
     MaxK(usize),
     #[error("k-means needs at least one run")]
     Runs,
+    #[error("the silhouette tolerance must be a non-negative number of standard errors, not {0}")]
+    Tolerance(f64),
 }
 
 impl ClusterParams {
@@ -66,6 +86,11 @@ impl ClusterParams {
         self
     }
 
+    pub fn tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+
     pub fn seed(mut self, seed: u64) -> Self {
         self.seed = seed;
         self
@@ -81,6 +106,9 @@ impl ClusterParams {
         }
         if self.runs == 0 {
             return Err(ClusterParamsError::Runs);
+        }
+        if !(self.tolerance >= 0.0 && self.tolerance.is_finite()) {
+            return Err(ClusterParamsError::Tolerance(self.tolerance));
         }
         Ok(ValidClusterParams(self.clone()))
     }
@@ -102,5 +130,6 @@ mod tests {
         assert_eq!(ClusterParams::new().k(Some(0)).check(), Err(ClusterParamsError::K));
         assert_eq!(ClusterParams::new().max_k(1).check(), Err(ClusterParamsError::MaxK(1)));
         assert_eq!(ClusterParams::new().runs(0).check(), Err(ClusterParamsError::Runs));
+        assert_eq!(ClusterParams::new().tolerance(-0.1).check(), Err(ClusterParamsError::Tolerance(-0.1)));
     }
 }

@@ -5,5 +5,5 @@
 mod algorithm;
 mod hyperparams;
 
-pub use algorithm::{Choice, ClusterError, Clustering};
+pub use algorithm::{Choice, ClusterError, Clustering, Tried, best};
 pub use hyperparams::{ClusterParams, ClusterParamsError, ValidClusterParams};

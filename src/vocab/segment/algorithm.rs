@@ -157,9 +157,17 @@ fn kinematic_centroid(
                 let back = returned
                     .map(|r| (r..limit - 1).find(|&t| dist(start, t + 1) >= dist(start, t)).unwrap_or(limit - 1));
                 // A return that retraces the way out is a second movement
-                // (the field could not tell the two directions apart).
+                // (the field could not tell the two directions apart); one
+                // that comes back to the limbs' place but not to the pose
+                // (the wrist turned the other way: half a wave) is not a
+                // whole cycle either.
                 match back {
-                    Some(b) if loop_openness(motion, start, turn, b) > retrace_share => (b, true),
+                    Some(b)
+                        if loop_openness(motion, start, turn, b) > retrace_share
+                            && pose_closure(motion, start, b) <= return_share =>
+                    {
+                        (b, true)
+                    }
                     _ => (turn, false),
                 }
             }
@@ -190,6 +198,16 @@ fn loop_openness(motion: &Motion, start: usize, turn: usize, back: usize) -> f64
     }
     let apart: f64 = ret.iter().map(|r| outward.iter().map(|o| distance(r, o)).fold(f64::INFINITY, f64::min)).sum();
     apart / SAMPLES as f64 / reach
+}
+
+/// How far a swing's last pose (`back`) is from its first in joint space,
+/// as a share of the farthest any of its poses gets from the first.
+fn pose_closure(motion: &Motion, start: usize, back: usize) -> f64 {
+    let first = &motion.poses[start].x;
+    let distance =
+        |t: usize| -> f64 { first.iter().zip(&motion.poses[t].x).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt() };
+    let farthest = (start..=back).map(distance).fold(0.0, f64::max);
+    if farthest > 0.0 { distance(back) / farthest } else { 0.0 }
 }
 
 /// Cuts at energy minima that dip below `dip_share` of the lower of the two
