@@ -20,10 +20,11 @@ fn version_and_help_list_the_built_subcommands() {
     assert!(out.status.success());
     assert_eq!(stdout_of(&out).trim(), format!("imitate {}", env!("CARGO_PKG_VERSION")));
     let help = stdout_of(&imitate().arg("--help").output().unwrap());
-    for sub in ["inspect", "retarget", "synth", "--quiet"] {
+    let built = ["inspect", "retarget", "synth", "segment", "embed", "cluster", "fit", "export", "vocab"];
+    for sub in built.iter().chain(&["--quiet"]) {
         assert!(help.contains(sub), "help lacks {sub}:\n{help}");
     }
-    for sub in ["inspect", "retarget", "synth"] {
+    for sub in built {
         let out = imitate().args([sub, "--help"]).output().unwrap();
         assert!(out.status.success(), "{sub} --help");
         assert!(stdout_of(&out).contains("Usage: imitate"), "{sub}");

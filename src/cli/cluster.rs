@@ -78,7 +78,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let params = args.cluster.params()?;
     let context = || "`imitate cluster` reads an embedding table (from `imitate embed`)".to_string();
     let embedded = Embedded::read(&args.embedding).with_context(context)?;
-    let clustered = cluster(embedded, &params, global)?;
+    let clustered = cluster(embedded, &params, global).with_context(|| args.embedding.display().to_string())?;
     clustered.write(&args.output)?;
     note(global, &format!("wrote {}", args.output.display()));
     Ok(Outcome::Success)

@@ -1,7 +1,7 @@
 //! `imitate embed`: spatio-temporal Isomap over segments.
 
 use super::learn::EmbedArgs;
-use super::{Global, Outcome, note, progress};
+use super::{Global, Outcome, count, note, progress};
 use anyhow::Context;
 use imitate::vocab::corpus::Corpus;
 use imitate::vocab::embed::ValidEmbedParams;
@@ -47,7 +47,8 @@ pub fn embed(
         0 => String::new(),
         n => format!("; {n} separate pieces of the graph joined at their closest segments"),
     };
-    note(global, &format!("{} segments embedded in {} dimensions ({kind}{joined})", embedding.len(), embedding.dims()));
+    let (segments_embedded, dims) = (count(embedding.len(), "segment"), count(embedding.dims(), "dimension"));
+    note(global, &format!("{segments_embedded} embedded in {dims} ({kind}{joined})"));
     segments.lineage.embed = Some(p.clone());
     Ok(Embedded { segments, embedding })
 }
@@ -59,7 +60,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let bar = progress(global, 1, "read");
     let corpus = segments.load_motion(&args.segments)?;
     bar.finish_and_clear();
-    let embedded = embed(&corpus, segments, &params, global)?;
+    let embedded = embed(&corpus, segments, &params, global).with_context(|| args.segments.display().to_string())?;
     embedded.write(&args.output)?;
     note(global, &format!("wrote {}", args.output.display()));
     Ok(Outcome::Success)

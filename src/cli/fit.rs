@@ -75,7 +75,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let bar = progress(global, 1, "read");
     let corpus = clustered.embedded.segments.load_motion(&args.clusters)?;
     bar.finish_and_clear();
-    let vocabulary = fit(&corpus, &clustered, &params, global)?;
+    let vocabulary = fit(&corpus, &clustered, &params, global).with_context(|| args.clusters.display().to_string())?;
     write_primitives(&vocabulary, &args.output)?;
     note(global, &format!("wrote {}", args.output.display()));
     Ok(Outcome::Success)

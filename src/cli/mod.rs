@@ -133,6 +133,11 @@ pub fn peak_resident_mb() -> Option<f64> {
     Some(kb * 1024.0 / 1e6)
 }
 
+/// `1 take`, `3 takes`.
+pub fn count(n: usize, noun: &str) -> String {
+    if n == 1 { format!("1 {noun}") } else { format!("{n} {noun}s") }
+}
+
 /// Prints a note on stderr unless `--quiet`.
 pub fn note(global: Global, text: &str) {
     if !global.quiet {

@@ -1,7 +1,8 @@
 //! `imitate segment`: cut takes into segments.
 
 use super::learn::{RetargetArgs, SegmentArgs};
-use super::{Global, Outcome, note, progress};
+use super::{Global, Outcome, count, note, progress};
+use anyhow::Context;
 use imitate::vocab::corpus::{self, Corpus, read_labels};
 use imitate::vocab::pipeline::segment_corpus;
 use imitate::vocab::segment::ValidSegmentParams;
@@ -52,6 +53,16 @@ pub fn load_corpus(
     Ok(corpus)
 }
 
+/// The takes a corpus was read from, for error messages: up to three
+/// files, then how many more.
+pub fn takes_named(corpus: &Corpus) -> String {
+    let paths: Vec<&str> = corpus.takes.iter().map(|t| t.path.as_str()).collect();
+    match paths.len() {
+        0..=3 => paths.join(", "),
+        n => format!("{} and {} more", paths[..3].join(", "), n - 3),
+    }
+}
+
 /// Segments a corpus and says what came of it.
 pub fn segment(
     corpus: &Corpus,
@@ -59,17 +70,18 @@ pub fn segment(
     lineage: Lineage,
     global: Global,
 ) -> anyhow::Result<Segments> {
-    let rows = segment_corpus(corpus, params)?;
+    let rows = segment_corpus(corpus, params).with_context(|| takes_named(corpus))?;
     let segments = Segments::new(lineage, corpus, rows);
     let cycles = segments.rows.iter().filter(|r| r.phase_offset.is_some()).count();
     let seconds: f64 = corpus.takes.iter().map(|t| t.motion.poses.len() as f64 * t.motion.frame_time_s).sum();
     note(
         global,
         &format!(
-            "{} takes ({} frames, {seconds:.1} s) → {} segments ({cycles} whole cycles)",
-            corpus.takes.len(),
-            corpus.frames(),
-            segments.rows.len()
+            "{} ({}, {seconds:.1} s) → {} ({})",
+            count(corpus.takes.len(), "take"),
+            count(corpus.frames(), "frame"),
+            count(segments.rows.len(), "segment"),
+            count(cycles, "whole cycle")
         ),
     );
     Ok(segments)

@@ -2,7 +2,8 @@
 //! vocab info`.
 
 use super::learn::{ClusterArgs, EmbedArgs, FitArgs, RetargetArgs, SegmentArgs};
-use super::{Global, Outcome, note, peak_resident_mb, write_stdout};
+use super::{Global, Outcome, count, note, peak_resident_mb, write_stdout};
+use anyhow::Context;
 use imitate::vocab::container::FORMAT_VERSION;
 use imitate::vocab::stages::Lineage;
 use imitate::vocab::vocabulary::Vocabulary;
@@ -109,16 +110,17 @@ fn build(args: BuildArgs, global: Global) -> anyhow::Result<Outcome> {
     times.push(stage.finish());
     let stage = Stage::start(global, "segment");
     let lineage = Lineage::new(settings, segment_params.params().clone());
+    let from = || super::segment::takes_named(&corpus);
     let segments = super::segment::segment(&corpus, &segment_params, lineage, global)?;
     times.push(stage.finish());
     let stage = Stage::start(global, "embed");
-    let embedded = super::embed::embed(&corpus, segments, &embed_params, global)?;
+    let embedded = super::embed::embed(&corpus, segments, &embed_params, global).with_context(from)?;
     times.push(stage.finish());
     let stage = Stage::start(global, "cluster");
-    let clustered = super::cluster::cluster(embedded, &cluster_params, global)?;
+    let clustered = super::cluster::cluster(embedded, &cluster_params, global).with_context(from)?;
     times.push(stage.finish());
     let stage = Stage::start(global, "fit");
-    let mut vocabulary = super::fit::fit(&corpus, &clustered, &fit_params, global)?;
+    let mut vocabulary = super::fit::fit(&corpus, &clustered, &fit_params, global).with_context(from)?;
     times.push(stage.finish());
     let stage = Stage::start(global, "write");
     vocabulary.save(&args.output)?;
@@ -136,9 +138,9 @@ fn build(args: BuildArgs, global: Global) -> anyhow::Result<Outcome> {
 pub fn saved(vocabulary: &Vocabulary, path: &Path) -> String {
     let bytes = std::fs::metadata(path).map_or(0, |m| m.len());
     format!(
-        "wrote {}: {} primitives, {:.1} KB, CRC-32 {:#010x}",
+        "wrote {}: {}, {:.1} KB, CRC-32 {:#010x}",
         path.display(),
-        vocabulary.primitives().len(),
+        count(vocabulary.primitives().len(), "primitive"),
         bytes as f64 / 1024.0,
         vocabulary.checksum().unwrap_or(0)
     )
@@ -175,11 +177,11 @@ fn describe(vocabulary: &Vocabulary, path: &Path, bytes: u64, checksum: &str) ->
             bytes as f64 / 1024.0
         ),
         format!(
-            "built by imitate {} from {} takes ({} frames, {} segments)",
+            "built by imitate {} from {} ({}, {})",
             l.imitate,
-            b.takes.len(),
-            b.frames,
-            b.segments
+            count(b.takes.len(), "take"),
+            count(b.frames, "frame"),
+            count(b.segments, "segment")
         ),
     ];
     let s = &l.segment;

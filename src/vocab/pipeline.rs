@@ -276,3 +276,61 @@ pub fn build(corpus: &Corpus, params: &BuildParams, mut stage: impl FnMut(&str))
     let fitted = fit_primitives(corpus, &segments, &clustering, &params.fit)?;
     Ok(Build { segments, embedding, clustering, fitted })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mocap::body::Body;
+    use crate::mocap::pose::{Motion, Pose};
+
+    /// One take of `swings` 20-frame swings along one curved path in joint
+    /// space, alternately out (rest to raised) and back when `both_ways`,
+    /// else always out, each a little larger than the last; one row each.
+    fn swings(swings: usize, both_ways: bool) -> (Corpus, Vec<SegmentRow>) {
+        let body = Body::standard();
+        let mut poses = Vec::new();
+        let mut rows = Vec::new();
+        for s in 0..swings {
+            let size = 1.0 + 0.03 * s as f64;
+            let back = both_ways && s % 2 == 1;
+            let first = poses.len();
+            for f in 0..20 {
+                let t = f as f64 / 19.0;
+                let along = if back { 1.0 - t } else { t };
+                let mut pose = Pose::rest(&body);
+                pose.x[10] = size * along;
+                pose.x[11] = size * along * along;
+                pose.x[12] = 0.3 * (3.0 * along).sin();
+                poses.push(pose);
+            }
+            let span = Span { first, last: poses.len() - 1 };
+            rows.push(SegmentRow { take: 0, span, phase_offset: None, label: None, label_share: 0.0 });
+        }
+        let mut corpus = Corpus::default();
+        corpus.push("swings.bvh".into(), Motion { body, frame_time_s: 1.0 / 30.0, poses }, None);
+        (corpus, rows)
+    }
+
+    #[test]
+    fn swings_along_one_path_both_ways_split_into_one_group_per_direction() {
+        let (corpus, rows) = swings(8, true);
+        let members: Vec<usize> = (0..rows.len()).collect();
+        let groups = direction_groups(&corpus, &rows, &members);
+        assert_eq!(groups, vec![vec![0, 2, 4, 6], vec![1, 3, 5, 7]]);
+    }
+
+    #[test]
+    fn swings_all_one_way_or_whole_cycles_stay_one_group() {
+        let (corpus, rows) = swings(8, false);
+        let members: Vec<usize> = (0..rows.len()).collect();
+        assert_eq!(direction_groups(&corpus, &rows, &members), vec![members.clone()]);
+        // Cycles travel their loop one way by construction: never split.
+        let (corpus, mut rows) = swings(8, true);
+        rows.iter_mut().for_each(|r| r.phase_offset = Some(0.0));
+        assert_eq!(direction_groups(&corpus, &rows, &members), vec![members]);
+        // One swing back is not a group of its own.
+        let (corpus, rows) = swings(3, true);
+        let members: Vec<usize> = (0..rows.len()).collect();
+        assert_eq!(direction_groups(&corpus, &rows, &members), vec![members]);
+    }
+}

@@ -37,6 +37,8 @@ pub const INDEX: &str = "index.json";
 
 /// The note under which a table records how it was made.
 const BUILD_NOTE: &str = "build";
+/// The note under which a table lists every take segmented.
+const TAKES_NOTE: &str = "takes";
 
 /// How the BVH files were retargeted, as given on the command line.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -129,12 +131,19 @@ pub enum StageError {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Segments {
     pub lineage: Lineage,
-    /// Each take's file, in take order.
-    pub files: Vec<String>,
-    /// Each take's number of frames and frame time.
-    pub take_frames: Vec<usize>,
-    pub frame_times: Vec<f64>,
+    /// Every take segmented, in take order: also those too short to give a
+    /// segment, so that a vocabulary records all it was given whether it
+    /// was built in one go or stage by stage.
+    pub takes: Vec<TakeRecord>,
     pub rows: Vec<SegmentRow>,
+}
+
+/// A take as a stage table records it (in its `takes` note).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TakeRecord {
+    pub file: String,
+    pub frames: usize,
+    pub frame_time_s: f64,
 }
 
 const SEGMENT_COLUMNS: [(&str, ColumnType); 10] = [
@@ -152,13 +161,16 @@ const SEGMENT_COLUMNS: [(&str, ColumnType); 10] = [
 
 impl Segments {
     pub fn new(lineage: Lineage, corpus: &Corpus, rows: Vec<SegmentRow>) -> Segments {
-        Segments {
-            lineage,
-            files: corpus.takes.iter().map(|t| t.path.clone()).collect(),
-            take_frames: corpus.takes.iter().map(|t| t.motion.poses.len()).collect(),
-            frame_times: corpus.takes.iter().map(|t| t.motion.frame_time_s).collect(),
-            rows,
-        }
+        let takes = corpus
+            .takes
+            .iter()
+            .map(|t| TakeRecord {
+                file: t.path.clone(),
+                frames: t.motion.poses.len(),
+                frame_time_s: t.motion.frame_time_s,
+            })
+            .collect();
+        Segments { lineage, takes, rows }
     }
 
     /// The segment columns of a table of `kind`.
@@ -166,20 +178,21 @@ impl Segments {
         let rows = &self.rows;
         let u32s = |f: &dyn Fn(&SegmentRow) -> usize| Values::U32(rows.iter().map(|r| f(r) as u32).collect());
         let mut t = Table::new(kind);
-        t.push("file", Values::Str(rows.iter().map(|r| self.files[r.take].clone()).collect()))
-            .push("take_frames", u32s(&|r| self.take_frames[r.take]))
+        t.push("file", Values::Str(rows.iter().map(|r| self.takes[r.take].file.clone()).collect()))
+            .push("take_frames", u32s(&|r| self.takes[r.take].frames))
             .push("first_frame", u32s(&|r| r.span.first))
             .push("last_frame", u32s(&|r| r.span.last))
             .push("frames", u32s(&|r| r.span.frames()))
             .push(
                 "duration_s",
-                Values::F64(rows.iter().map(|r| r.span.frames() as f64 * self.frame_times[r.take]).collect()),
+                Values::F64(rows.iter().map(|r| r.span.frames() as f64 * self.takes[r.take].frame_time_s).collect()),
             )
             .push("cyclic", u32s(&|r| usize::from(r.phase_offset.is_some())))
             .push("phase_offset", Values::F64(rows.iter().map(|r| r.phase_offset.unwrap_or(0.0)).collect()))
             .push("label", Values::OptStr(rows.iter().map(|r| r.label.clone()).collect()))
             .push("label_share", Values::F64(rows.iter().map(|r| r.label_share).collect()));
         t.set_meta(BUILD_NOTE, serde_json::to_string(&self.lineage).expect("settings serialize"));
+        t.set_meta(TAKES_NOTE, serde_json::to_string(&self.takes).expect("takes serialize"));
         t
     }
 
@@ -198,37 +211,36 @@ impl Segments {
         let schema: Vec<(&str, ColumnType)> = SEGMENT_COLUMNS.iter().chain(extra).copied().collect();
         let table = Table::read(path, kind, &schema)?;
         let name = path.display().to_string();
-        let lineage: Lineage = table
-            .meta(BUILD_NOTE)
-            .ok_or_else(|| StageError::Bad {
+        let note = |key: &str, what: &str| {
+            let text = table.meta(key).ok_or_else(|| StageError::Bad {
                 path: name.clone(),
-                problem: format!("no `{BUILD_NOTE}` note saying how it was made (was it written by imitate?)"),
-            })
-            .and_then(|text| {
-                serde_json::from_str(text).map_err(|e| StageError::Bad {
-                    path: name.clone(),
-                    problem: format!("its `{BUILD_NOTE}` note is not imitate's: {e}"),
-                })
+                problem: format!("no `{key}` note saying {what} (was it written by imitate?)"),
             })?;
+            Ok::<_, StageError>((key.to_string(), text))
+        };
+        let parse_error = |(key, e): (String, serde_json::Error)| StageError::Bad {
+            path: name.clone(),
+            problem: format!("its `{key}` note is not imitate's: {e}"),
+        };
+        let (key, text) = note(BUILD_NOTE, "how it was made")?;
+        let lineage: Lineage = serde_json::from_str(text).map_err(|e| parse_error((key, e)))?;
+        let (key, text) = note(TAKES_NOTE, "which takes were segmented")?;
+        let takes: Vec<TakeRecord> = serde_json::from_str(text).map_err(|e| parse_error((key, e)))?;
         let bad = |row: usize, problem: String| StageError::BadRow { path: name.clone(), row: row + 1, problem };
         if table.rows() == 0 {
             return Err(StageError::Bad { path: name, problem: "no segments".into() });
         }
-        let mut segments =
-            Segments { lineage, files: Vec::new(), take_frames: Vec::new(), frame_times: Vec::new(), rows: Vec::new() };
+        let mut segments = Segments { lineage, takes, rows: Vec::new() };
         let (file, take_frames) = (table.str("file"), table.u32("take_frames"));
         let (first, last, frames) = (table.u32("first_frame"), table.u32("last_frame"), table.u32("frames"));
-        let (duration, cyclic, offset) = (table.f64("duration_s"), table.u32("cyclic"), table.f64("phase_offset"));
+        let (cyclic, offset) = (table.u32("cyclic"), table.f64("phase_offset"));
         let (label, share) = (table.opt_str("label"), table.f64("label_share"));
         for i in 0..table.rows() {
-            let take = match segments.files.iter().position(|f| *f == file[i]) {
-                Some(t) => t,
-                None => {
-                    segments.files.push(file[i].clone());
-                    segments.take_frames.push(take_frames[i] as usize);
-                    segments.frame_times.push(duration[i] / f64::from(frames[i].max(1)));
-                    segments.files.len() - 1
-                }
+            let Some(take) = segments.takes.iter().position(|t| t.file == file[i]) else {
+                return Err(bad(
+                    i,
+                    format!("its file {} is not among the takes its `{TAKES_NOTE}` note lists", file[i]),
+                ));
             };
             let span = Span { first: first[i] as usize, last: last[i] as usize };
             if span.first > span.last || span.last >= take_frames[i] as usize {
@@ -238,7 +250,7 @@ impl Segments {
                     format!("frames {}–{} do not lie within the take's {take} frames", span.first, span.last),
                 ));
             }
-            if frames[i] as usize != span.frames() || take_frames[i] as usize != segments.take_frames[take] {
+            if frames[i] as usize != span.frames() || take_frames[i] as usize != segments.takes[take].frames {
                 return Err(bad(i, "its frame counts disagree with each other".into()));
             }
             if let Some(previous) = segments.rows.last()
@@ -273,9 +285,9 @@ impl Segments {
     /// refuses a file whose length changed since it was segmented.
     pub fn load_motion(&self, table_path: &Path) -> Result<Corpus, StageError> {
         let options = self.lineage.retarget.options()?;
-        let files: Vec<PathBuf> = self.files.iter().map(PathBuf::from).collect();
+        let files: Vec<PathBuf> = self.takes.iter().map(|t| PathBuf::from(&t.file)).collect();
         let corpus = corpus::load(&files, &options, None)?;
-        for (take, &expected) in corpus.takes.iter().zip(&self.take_frames) {
+        for (take, expected) in corpus.takes.iter().zip(self.takes.iter().map(|t| t.frames)) {
             if take.motion.poses.len() != expected {
                 return Err(StageError::Bad {
                     path: take.path.clone(),
@@ -443,11 +455,15 @@ pub fn write_primitives(vocabulary: &Vocabulary, dir: &Path) -> Result<(), Stage
 
 /// Reads a primitives folder back into a vocabulary.
 pub fn read_primitives(dir: &Path) -> Result<Vocabulary, StageError> {
+    if !dir.is_dir() {
+        let problem = if dir.exists() { "is a file, not a primitives folder" } else { "does not exist" };
+        return Err(StageError::Bad { path: dir.display().to_string(), problem: problem.to_string() });
+    }
     let index = dir.join(INDEX);
     let name = index.display().to_string();
     let text = std::fs::read_to_string(&index).map_err(|source| StageError::Io {
         path: name.clone(),
-        action: "read (is this a primitives folder written by `imitate fit`?)",
+        action: "read the primitives index",
         source,
     })?;
     let header: Header = serde_json::from_str(&text)
@@ -520,9 +536,74 @@ pub fn build_info(lineage: &Lineage, fit: &FitParams, segments: &Segments, still
     BuildInfo {
         lineage: lineage.clone(),
         fit: fit.clone(),
-        takes: segments.files.clone(),
-        frames: segments.take_frames.iter().sum(),
+        takes: segments.takes.iter().map(|t| t.file.clone()).collect(),
+        frames: segments.takes.iter().map(|t| t.frames).sum(),
         segments: segments.rows.len(),
         still,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mocap::body::Body;
+    use crate::mocap::pose::{Motion, Pose};
+
+    fn still_take(frames: usize, frame_time_s: f64) -> Motion {
+        let body = Body::standard();
+        Motion { poses: vec![Pose::rest(&body); frames], body, frame_time_s }
+    }
+
+    /// Two takes with segments and one, between them, with none.
+    fn segments() -> Segments {
+        let mut corpus = Corpus::default();
+        corpus.push("a.bvh".into(), still_take(90, 1.0 / 30.0), None);
+        corpus.push("too short.bvh".into(), still_take(3, 1.0 / 30.0), None);
+        corpus.push("b, with comma.bvh".into(), still_take(500, 1.0 / 120.0), None);
+        let row = |take, first, last, phase_offset: Option<f64>, label: Option<&str>, label_share| SegmentRow {
+            take,
+            span: Span { first, last },
+            phase_offset,
+            label: label.map(str::to_string),
+            label_share,
+        };
+        let rows = vec![
+            row(0, 0, 29, None, Some("wave"), 1.0),
+            row(0, 30, 89, Some(0.25), Some("wave"), 0.75),
+            row(2, 10, 499, Some(0.0), None, 0.0),
+        ];
+        let settings = RetargetSettings::new(Some(UpAxis::Z), None);
+        Segments::new(Lineage::new(settings, SegmentParams::default()), &corpus, rows)
+    }
+
+    #[test]
+    fn segments_tables_read_back_equal_in_csv_and_parquet_with_every_take_listed() {
+        let dir = tempfile::tempdir().unwrap();
+        let original = segments();
+        for name in ["s.csv", "s.parquet"] {
+            let path = dir.path().join(name);
+            original.write(&path).unwrap();
+            let back = Segments::read(&path).unwrap();
+            assert_eq!(back, original, "{name}");
+            assert_eq!(back.takes[1], TakeRecord { file: "too short.bvh".into(), frames: 3, frame_time_s: 1.0 / 30.0 });
+        }
+    }
+
+    #[test]
+    fn a_segments_table_must_list_its_takes_and_name_only_those() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.csv");
+        segments().write(&path).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let without: String = text.lines().filter(|l| !l.starts_with("# takes:")).map(|l| format!("{l}\n")).collect();
+        std::fs::write(&path, without).unwrap();
+        let err = Segments::read(&path).unwrap_err().to_string();
+        assert!(err.contains("no `takes` note"), "{err}");
+
+        segments().write(&path).unwrap();
+        let renamed = std::fs::read_to_string(&path).unwrap().replace("\na.bvh,", "\nc.bvh,");
+        std::fs::write(&path, renamed).unwrap();
+        let err = Segments::read(&path).unwrap_err().to_string();
+        assert!(err.contains("row 1: its file c.bvh is not among the takes"), "{err}");
     }
 }

@@ -181,7 +181,7 @@ pub enum TableError {
     Unreadable { path: String, format: &'static str, message: String },
     #[error("{path}: does not say what kind of table it is; a `{expected}` table declares itself with {declaration}")]
     Undeclared { path: String, expected: &'static str, declaration: String },
-    #[error("{path} is a `{found}` table, but a table of kind `{expected}` is needed here")]
+    #[error("{path} holds a table of kind `{found}`, but a table of kind `{expected}` is needed here")]
     WrongKind { path: String, found: String, expected: &'static str },
     #[error("{path}: the `{kind}` table has no column `{column}`; its columns are: {present}")]
     MissingColumn { path: String, kind: &'static str, column: String, present: String },
@@ -1000,7 +1000,10 @@ mod tests {
             let message = err_text(Table::read(&path, "clusters", &[("cluster", ColumnType::U32)]));
             assert_eq!(
                 message,
-                format!("{} is a `embedding` table, but a table of kind `clusters` is needed here", path.display())
+                format!(
+                    "{} holds a table of kind `embedding`, but a table of kind `clusters` is needed here",
+                    path.display()
+                )
             );
         }
     }

@@ -63,7 +63,7 @@ impl Embedding {
 pub enum EmbedError {
     #[error("only {0} segments: an embedding needs at least 3")]
     TooFewSegments(usize),
-    #[error("{dims} dimensions asked of {segments} segments: at most {} are possible", .segments - 1)]
+    #[error("{segments} segments can be embedded in at most {} dimensions, not the {dims} asked (--dims)", .segments - 1)]
     TooManyDims { dims: usize, segments: usize },
     #[error("every segment is the same motion: there is nothing to tell apart")]
     AllIdentical,
