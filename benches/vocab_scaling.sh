@@ -4,9 +4,10 @@
 # speed, a new seed per take), then builds a vocabulary from the first
 # 10k, 50k, 100k and 432k frames (one hour) of them, the last take cut to
 # size. Prints frames, seconds per stage, total seconds and peak memory, as
-# `imitate vocab build` reports them.
+# `imitate vocab build` reports them, and the segments and k found.
 #
 #   bash benches/vocab_scaling.sh [FRAMES...]   (default: 10000 50000 100000 432000)
+#   BUILD_ARGS="--eigen full" bash benches/vocab_scaling.sh 432000   (other settings)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 targets=("${@:-10000 50000 100000 432000}")
@@ -57,6 +58,10 @@ for target in "${targets[@]}"; do
             left=0
         fi
     done
-    line=$("$imitate" vocab build "$dir" -o "$work/v.vocab" 2>&1 | grep '^time:')
-    printf '%8d  %s\n' "$target" "${line#time: }"
+    # shellcheck disable=SC2086 # BUILD_ARGS is a list of flags
+    out=$("$imitate" vocab build "$dir" -o "$work/v.vocab" ${BUILD_ARGS:-} 2>&1)
+    segments=$(grep -o '→ [0-9]* segments' <<<"$out" | head -1)
+    k=$(grep -o 'k = [0-9]*' <<<"$out" | head -1)
+    line=$(grep '^time:' <<<"$out")
+    printf '%8d  %s (%s, %s)\n' "$target" "${line#time: }" "${segments#→ }" "$k"
 done

@@ -58,6 +58,16 @@ fn fields_and_progress_hold_on_held_out_repetitions() {
         let moving = report.repetitions.iter().filter(|r| r.travel > 0.0 && r.activity != "rest");
         let activities: std::collections::BTreeSet<&str> = moving.clone().map(|r| r.activity.as_str()).collect();
         assert_eq!(activities.len(), 4, "seed {s}: {activities:?}");
+        // The primitive nearest to each held-out repetition is its own
+        // activity's (`wave-h` or `wave-h-2` for horizontal waving).
+        for r in report.repetitions.iter().filter(|r| r.activity != "rest") {
+            let own = r.primitive == r.activity || r.primitive.starts_with(&format!("{}-", r.activity));
+            assert!(
+                own,
+                "seed {s}: {} {}-{} ({}) is nearest to {}",
+                r.file, r.first_frame, r.last_frame, r.activity, r.primitive
+            );
+        }
         let latent = report.mean_direction(|r| r.latent_cosine);
         let joint = report.mean_direction(|r| r.joint_agreement);
         assert!(latent >= 0.90, "seed {s}: latent field cosine {latent:.3}");

@@ -213,7 +213,8 @@ fn unwrap_cycles(phases: &[f64]) -> Vec<f64> {
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct HeldOutReport {
     pub repetitions: Vec<RepetitionCheck>,
-    /// Held-out activities no primitive is named after.
+    /// Held-out activities no primitive is named after (checked all the
+    /// same, with the primitive nearest to each segment).
     pub unmatched: Vec<String>,
 }
 
@@ -238,11 +239,13 @@ impl HeldOutReport {
 }
 
 /// Segments `held_out` (labelled) as the build was segmented, and checks
-/// each whole-activity segment with the primitive of its activity
-/// (`circles`, `circles-2`, … all belong to `circles`) whose training
-/// segments hold the one nearest to it, compared as the embedding compares
-/// segments. Joint-space fields are fitted to each primitive's training
-/// segments.
+/// each whole-activity segment with the primitive whose training segments
+/// hold the one nearest to it, compared as the embedding compares segments.
+/// The primitive is chosen from the motion alone, as tracking chooses it,
+/// not by label: a coarse label (`gesture` for eight unrelated motions,
+/// `walk` for a walk and a zombie shuffle) can name a primitive learned
+/// from a different movement, whose field says nothing about this one.
+/// Joint-space fields are fitted to each primitive's training segments.
 pub fn check_held_out(
     build: &Build,
     training: &Corpus,
@@ -258,37 +261,36 @@ pub fn check_held_out(
     // The primitive fitted to each training segment's cluster, if any.
     let primitive_of: Vec<Option<usize>> =
         (0..build.segments.len()).map(|i| fitted.members.iter().position(|m| m.contains(&i))).collect();
-    let activity_of = |p: usize| {
-        let name = fitted.primitives[p].name();
-        name.rsplit_once('-').filter(|(_, n)| n.parse::<u32>().is_ok()).map_or(name, |(a, _)| a)
-    };
-    let checks: Vec<Result<RepetitionCheck, String>> = rows
+    // `circles`, `circles-2`, … all belong to `circles`.
+    let activities: BTreeSet<&str> = fitted
+        .primitives
+        .iter()
+        .map(|p| p.name())
+        .map(|name| name.rsplit_once('-').filter(|(_, n)| n.parse::<u32>().is_ok()).map_or(name, |(a, _)| a))
+        .collect();
+    let repetitions: Vec<RepetitionCheck> = rows
         .par_iter()
         .zip(&fresh)
         .filter(|(r, _)| r.label.is_some() && r.label_share >= WHOLE_ACTIVITY_SHARE)
-        .map(|(r, vector)| {
-            let label = r.label.clone().expect("filtered to labelled segments");
-            let nearest = (0..known.len())
-                .filter_map(|i| primitive_of[i].filter(|&p| activity_of(p) == label).map(|p| (i, p)))
-                .min_by(|a, b| squared_distance(vector, &known[a.0]).total_cmp(&squared_distance(vector, &known[b.0])));
-            let Some((_, p)) = nearest else { return Err(label) };
+        .filter_map(|(r, vector)| {
+            let (_, p) = (0..known.len()).filter_map(|i| primitive_of[i].map(|p| (i, p))).min_by(|a, b| {
+                squared_distance(vector, &known[a.0]).total_cmp(&squared_distance(vector, &known[b.0]))
+            })?;
             let motion = &held_out.takes[r.take].motion;
             let mut check = check_repetition(&fitted.primitives[p], &joint_fields[p], motion, r.span);
-            check.activity = label;
+            check.activity = r.label.clone().expect("filtered to labelled segments");
             check.file = held_out.takes[r.take].path.clone();
             check.cyclic = r.phase_offset.is_some();
-            Ok(check)
+            Some(check)
         })
         .collect();
-    let mut report = HeldOutReport { repetitions: Vec::new(), unmatched: Vec::new() };
-    for check in checks {
-        match check {
-            Ok(c) => report.repetitions.push(c),
-            Err(label) if !report.unmatched.contains(&label) => report.unmatched.push(label),
-            Err(_) => {}
+    let mut unmatched: Vec<String> = Vec::new();
+    for r in &repetitions {
+        if !activities.contains(r.activity.as_str()) && !unmatched.contains(&r.activity) {
+            unmatched.push(r.activity.clone());
         }
     }
-    Ok(report)
+    Ok(HeldOutReport { repetitions, unmatched })
 }
 
 fn squared_distance(a: &[f64], b: &[f64]) -> f64 {
