@@ -9,8 +9,9 @@ use imitate::vocab::stages::{ClusterRecord, Clustered, Embedded};
 use std::path::PathBuf;
 
 /// Group embedded segments into primitives by k-means (linfa). Without
-/// `--k`, the number of primitives is the k with the highest mean
-/// silhouette, and the command says so.
+/// `--k`, k is the largest whose mean silhouette lies within `--tolerance`
+/// standard errors of the best, among clusterings whose every cluster holds
+/// `--min-size` segments, and the command says so.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// An embedding table from `imitate embed`.

@@ -154,8 +154,9 @@ impl EmbedArgs {
 #[derive(Debug, clap::Args)]
 #[command(next_help_heading = "Clustering")]
 pub struct ClusterArgs {
-    /// The number of primitives; without it, the k from 2 to --max-k with
-    /// the highest mean silhouette.
+    /// The number of clusters, each a primitive (two when its swings travel
+    /// one path both ways); without it, chosen by mean silhouette among k
+    /// from 2 to --max-k (see --min-size and --tolerance).
     #[arg(long, value_name = "N")]
     pub k: Option<usize>,
     /// The largest number of primitives tried.

@@ -4,6 +4,7 @@
 use super::learn::{ClusterArgs, EmbedArgs, FitArgs, RetargetArgs, SegmentArgs};
 use super::{Global, Outcome, count, note, peak_resident_mb, write_stdout};
 use anyhow::Context;
+use imitate::vocab::cluster::Choice;
 use imitate::vocab::container::FORMAT_VERSION;
 use imitate::vocab::stages::Lineage;
 use imitate::vocab::vocabulary::Vocabulary;
@@ -198,12 +199,12 @@ fn describe(vocabulary: &Vocabulary, path: &Path, bytes: u64, checksum: &str) ->
         ));
     }
     if let Some(c) = &l.cluster {
-        let k = vocabulary.primitives().len() + b.still.len();
-        let chosen = c.tried.iter().find(|t| t.k == k).map_or(f64::NAN, |t| t.silhouette);
-        out.push(
-            format!("  cluster: k = {k} ({:?}; mean silhouette {chosen:.3}), seed {}", c.choice, c.params.seed)
-                .to_lowercase(),
-        );
+        let chosen = c.tried.iter().find(|t| t.k == c.k).map_or(f64::NAN, |t| t.silhouette);
+        let how = match c.choice {
+            Choice::Given => format!("as given (mean silhouette {chosen:.3})"),
+            Choice::Silhouette => format!("chosen by mean silhouette ({chosen:.3})"),
+        };
+        out.push(format!("  cluster: k = {} {how}, seed {}", c.k, c.params.seed));
     }
     let f = &b.fit;
     out.push(format!(

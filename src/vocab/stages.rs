@@ -77,6 +77,9 @@ impl RetargetSettings {
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ClusterRecord {
     pub params: ClusterParams,
+    /// The number of clusters (primitives can be more: see
+    /// [`crate::vocab::pipeline::fit_primitives`]).
+    pub k: usize,
     pub choice: Choice,
     /// Each k tried: mean silhouette and smallest cluster.
     pub tried: Vec<Tried>,
@@ -84,7 +87,12 @@ pub struct ClusterRecord {
 
 impl ClusterRecord {
     pub fn new(params: ClusterParams, clustering: &Clustering) -> ClusterRecord {
-        ClusterRecord { params, choice: clustering.choice().clone(), tried: clustering.scores().to_vec() }
+        ClusterRecord {
+            params,
+            k: clustering.k(),
+            choice: clustering.choice().clone(),
+            tried: clustering.scores().to_vec(),
+        }
     }
 }
 

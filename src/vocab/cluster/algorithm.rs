@@ -16,7 +16,7 @@ use rayon::prelude::*;
 pub enum Choice {
     /// Given with `--k`.
     Given,
-    /// The k with the highest mean silhouette.
+    /// Chosen by mean silhouette (see [`best`] and `ClusterParams::tolerance`).
     Silhouette,
 }
 
