@@ -49,7 +49,8 @@ impl KnnIndex {
     /// [`MAX_LATENT_DIMS`], or the joint-space dimension). `None` for an
     /// unsupported dimension, no points, or non-finite coordinates.
     pub fn new(points: &[f64], dims: usize) -> Option<KnnIndex> {
-        if dims == 0 || points.is_empty() || points.len() % dims != 0 || points.iter().any(|v| !v.is_finite()) {
+        if dims == 0 || points.is_empty() || !points.len().is_multiple_of(dims) || points.iter().any(|v| !v.is_finite())
+        {
             return None;
         }
         let search = match dims {
