@@ -11,9 +11,18 @@ use imitate::vocab::segment::{Method, SegmentParams, ValidSegmentParams};
 use imitate::vocab::stages::RetargetSettings;
 use std::path::PathBuf;
 
-/// How the BVH files are put onto the canonical body.
+/// The takes a learning command reads, their labels, and how they are put
+/// onto the canonical body.
 #[derive(Debug, clap::Args)]
-pub struct RetargetArgs {
+pub struct TakesArgs {
+    /// BVH files, or folders whose `.bvh` files are all read.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// Activity labels, used only to name primitives and to score the
+    /// clustering: `file,activity` per file, `frame,activity` per frame of
+    /// one take (as `synth --sequence` writes) or `file,frame,activity`.
+    #[arg(long, value_name = "LABELS.csv")]
+    pub labels: Option<PathBuf>,
     /// The sources' up axis, when detection from the skeleton gets it wrong.
     #[arg(long, value_enum)]
     pub up: Option<UpArg>,
@@ -22,7 +31,7 @@ pub struct RetargetArgs {
     pub mapping: Option<PathBuf>,
 }
 
-impl RetargetArgs {
+impl TakesArgs {
     pub fn settings(&self) -> RetargetSettings {
         RetargetSettings::new(self.up.map(Into::into), self.mapping.as_deref())
     }

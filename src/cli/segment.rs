@@ -1,13 +1,13 @@
 //! `imitate segment`: cut takes into segments.
 
-use super::learn::{RetargetArgs, SegmentArgs};
+use super::learn::{SegmentArgs, TakesArgs};
 use super::{Global, Outcome, count, note, progress};
 use anyhow::Context;
 use imitate::vocab::corpus::{self, Corpus, read_labels};
 use imitate::vocab::pipeline::segment_corpus;
 use imitate::vocab::segment::ValidSegmentParams;
 use imitate::vocab::stages::{Lineage, RetargetSettings, Segments};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Cut BVH takes into segments (one row per segment: file, frames,
 /// duration, whether it is a whole cycle, label).
@@ -15,33 +15,21 @@ use std::path::{Path, PathBuf};
 /// Writes a `segments` table, Parquet or CSV by the output's extension.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// BVH files, or folders whose `.bvh` files are all read.
-    #[arg(required = true)]
-    pub inputs: Vec<PathBuf>,
+    #[command(flatten)]
+    pub takes: TakesArgs,
     /// The segments table to write (`.parquet` or `.csv`).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Activity labels, used only to name and score: `file,activity` per
-    /// file, `frame,activity` per frame of one take (as `synth --sequence`
-    /// writes) or `file,frame,activity`.
-    #[arg(long, value_name = "LABELS.csv")]
-    pub labels: Option<PathBuf>,
-    #[command(flatten)]
-    pub retarget: RetargetArgs,
     #[command(flatten)]
     pub segment: SegmentArgs,
 }
 
 /// Reads and retargets the inputs, with their labels.
-pub fn load_corpus(
-    inputs: &[PathBuf],
-    labels: Option<&Path>,
-    retarget: &RetargetSettings,
-    global: Global,
-) -> anyhow::Result<Corpus> {
+pub fn load_corpus(takes: &TakesArgs, retarget: &RetargetSettings, global: Global) -> anyhow::Result<Corpus> {
+    let labels = takes.labels.as_deref();
     let labels = labels.map(|path| read_labels(path).map(|l| (l, path.display().to_string()))).transpose()?;
     let bar = progress(global, 1, "read");
-    let corpus = corpus::load(inputs, &retarget.options()?, labels.as_ref().map(|(l, p)| (l, p.as_str())))?;
+    let corpus = corpus::load(&takes.inputs, &retarget.options()?, labels.as_ref().map(|(l, p)| (l, p.as_str())))?;
     bar.finish_and_clear();
     if let Some((_, path)) = &labels {
         let unlabelled: Vec<&str> =
@@ -89,8 +77,8 @@ pub fn segment(
 
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let params = args.segment.params()?;
-    let settings = args.retarget.settings();
-    let corpus = load_corpus(&args.inputs, args.labels.as_deref(), &settings, global)?;
+    let settings = args.takes.settings();
+    let corpus = load_corpus(&args.takes, &settings, global)?;
     let segments = segment(&corpus, &params, Lineage::new(settings, params.params().clone()), global)?;
     segments.write(&args.output)?;
     note(global, &format!("wrote {}", args.output.display()));

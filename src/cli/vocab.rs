@@ -1,7 +1,7 @@
 //! `imitate vocab build` (every learning stage in one go) and `imitate
 //! vocab info`.
 
-use super::learn::{ClusterArgs, EmbedArgs, FitArgs, RetargetArgs, SegmentArgs};
+use super::learn::{ClusterArgs, EmbedArgs, FitArgs, SegmentArgs, TakesArgs};
 use super::{Global, Outcome, count, note, peak_resident_mb, write_stdout};
 use anyhow::Context;
 use imitate::vocab::cluster::Choice;
@@ -31,18 +31,11 @@ pub enum Command {
 /// print how long each stage took.
 #[derive(Debug, clap::Args)]
 pub struct BuildArgs {
-    /// BVH files, or folders whose `.bvh` files are all read.
-    #[arg(required = true)]
-    pub inputs: Vec<PathBuf>,
+    #[command(flatten)]
+    pub takes: TakesArgs,
     /// The vocabulary file to write, e.g. `vocab/NAME.vocab`.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Activity labels, used only to name primitives and to score the
-    /// clustering (formats as for `imitate segment`).
-    #[arg(long, value_name = "LABELS.csv")]
-    pub labels: Option<PathBuf>,
-    #[command(flatten)]
-    pub retarget: RetargetArgs,
     #[command(flatten)]
     pub segment: SegmentArgs,
     #[command(flatten)]
@@ -103,11 +96,11 @@ impl Stage {
 fn build(args: BuildArgs, global: Global) -> anyhow::Result<Outcome> {
     let (segment_params, embed_params) = (args.segment.params()?, args.embed.params()?);
     let (cluster_params, fit_params) = (args.cluster.params()?, args.fit.params()?);
-    let settings = args.retarget.settings();
+    let settings = args.takes.settings();
     let mut times = Vec::new();
 
     let stage = Stage::start(global, "read");
-    let corpus = super::segment::load_corpus(&args.inputs, args.labels.as_deref(), &settings, global)?;
+    let corpus = super::segment::load_corpus(&args.takes, &settings, global)?;
     times.push(stage.finish());
     let stage = Stage::start(global, "segment");
     let lineage = Lineage::new(settings, segment_params.params().clone());

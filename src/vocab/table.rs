@@ -717,33 +717,30 @@ fn csv_values(ctx: &Ctx, name: &str, ty: ColumnType, text: &StringChunked) -> Re
         }
     }
     let not_a = |i: usize, s: &str| ctx.wrong_type(name, ty, format!("`{}` in row {}", shorten(s, 40), i + 1));
-    let integer = |i: usize, s: Option<&str>| -> Result<i128, TableError> {
+    // A row's integer, with its row.
+    let integer = |(i, s): (usize, Option<&str>)| -> Result<(usize, i128), TableError> {
         let s = number(ctx, name, i, s)?;
-        s.parse::<i128>().map_err(|_| not_a(i, s))
+        s.parse::<i128>().map(|v| (i, v)).map_err(|_| not_a(i, s))
     };
+    let out_of_range = |i: usize, v: i128| ctx.out_of_range(name, i, v.to_string(), ty);
+    /// Each row's integer as a `T`, if it fits.
+    fn narrowed<T: TryFrom<i128>>(
+        rows: impl Iterator<Item = Result<(usize, i128), TableError>>,
+        out_of_range: impl Fn(usize, i128) -> TableError,
+    ) -> Result<Vec<T>, TableError> {
+        rows.map(|row| {
+            let (i, v) = row?;
+            T::try_from(v).map_err(|_| out_of_range(i, v))
+        })
+        .collect()
+    }
     Ok(match ty {
         // An empty field is the empty text in a text column (other tools
         // write "" unquoted) and an absent value in an optional one.
         ColumnType::Str => Values::Str(cells.map(|s| s.unwrap_or("").to_owned()).collect()),
         ColumnType::OptStr => Values::OptStr(cells.map(|s| s.map(str::to_owned)).collect()),
-        ColumnType::U32 => Values::U32(
-            cells
-                .enumerate()
-                .map(|(i, s)| {
-                    let v = integer(i, s)?;
-                    u32::try_from(v).map_err(|_| ctx.out_of_range(name, i, v.to_string(), ty))
-                })
-                .collect::<Result<_, _>>()?,
-        ),
-        ColumnType::I32 => Values::I32(
-            cells
-                .enumerate()
-                .map(|(i, s)| {
-                    let v = integer(i, s)?;
-                    i32::try_from(v).map_err(|_| ctx.out_of_range(name, i, v.to_string(), ty))
-                })
-                .collect::<Result<_, _>>()?,
-        ),
+        ColumnType::U32 => Values::U32(narrowed(cells.enumerate().map(integer), out_of_range)?),
+        ColumnType::I32 => Values::I32(narrowed(cells.enumerate().map(integer), out_of_range)?),
         ColumnType::F64 => Values::F64(
             cells
                 .enumerate()
