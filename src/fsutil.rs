@@ -26,9 +26,41 @@ where
     result
 }
 
+/// Writes the folder `dir` through `fill`, which writes into the (empty)
+/// folder it is given, atomically: the folder is made beside `dir` and
+/// put in its place (replacing an existing `dir`) only once `fill` has
+/// succeeded; an error from `fill` or from the file system (turned into
+/// `E` by `io_error`) leaves nothing behind and `dir` as it was.
+pub fn write_dir_atomic<E>(
+    dir: &Path,
+    fill: impl FnOnce(&Path) -> Result<(), E>,
+    io_error: impl Fn(io::Error) -> E,
+) -> Result<(), E> {
+    let staging = sibling(dir, "tmp");
+    let _ = fs::remove_dir_all(&staging);
+    let result = fs::create_dir_all(&staging).map_err(&io_error).and_then(|()| fill(&staging)).and_then(|()| {
+        if dir.exists() {
+            let old = sibling(dir, "old");
+            fs::rename(dir, &old).and_then(|()| fs::rename(&staging, dir)).map_err(&io_error)?;
+            fs::remove_dir_all(&old).map_err(&io_error)
+        } else {
+            fs::rename(&staging, dir).map_err(&io_error)
+        }
+    });
+    if result.is_err() {
+        let _ = fs::remove_dir_all(&staging);
+    }
+    result
+}
+
 fn temporary_sibling(path: &Path) -> PathBuf {
+    sibling(path, "tmp")
+}
+
+/// A hidden name beside `path` for work in progress: `.<name>.<what>.<pid>`.
+fn sibling(path: &Path, what: &str) -> PathBuf {
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+    path.with_file_name(format!(".{name}.{what}.{}", std::process::id()))
 }
 
 #[cfg(test)]
@@ -45,6 +77,28 @@ mod tests {
         });
         assert!(err.is_err());
         assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+
+    #[test]
+    fn a_folder_is_written_whole_or_not_at_all() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out");
+        let fill = |ok: bool| {
+            move |d: &Path| {
+                fs::write(d.join("a.txt"), if ok { "new" } else { "partial" })?;
+                if ok { Ok(()) } else { Err(io::Error::other("boom")) }
+            }
+        };
+        assert!(write_dir_atomic(&target, fill(false), |e| e).is_err());
+        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 0);
+        fs::create_dir(&target).unwrap();
+        fs::write(target.join("old.txt"), "old").unwrap();
+        assert!(write_dir_atomic(&target, fill(false), |e| e).is_err());
+        assert!(target.join("old.txt").exists() && !target.join("a.txt").exists());
+        write_dir_atomic(&target, fill(true), |e| e).unwrap();
+        assert_eq!(fs::read_to_string(target.join("a.txt")).unwrap(), "new");
+        assert!(!target.join("old.txt").exists());
+        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[test]

@@ -14,6 +14,7 @@
 //! as JSON in its `build` note), and the stages after `segment` read the
 //! motion again from the files it names, retargeted the same way.
 
+use crate::fsutil::write_dir_atomic;
 use crate::mocap::body::{DOF, Joint, Kind};
 use crate::mocap::names::{MappingError, UserMapping};
 use crate::mocap::retarget::{RetargetOptions, UpAxis};
@@ -418,13 +419,10 @@ pub fn dof_names() -> Vec<String> {
 /// `v_0 …` per second, `phase`). The folder is written whole or not at all.
 pub fn write_primitives(vocabulary: &Vocabulary, dir: &Path) -> Result<(), StageError> {
     let (header, arrays) = vocabulary.to_parts();
-    let io = |action, source| StageError::Io { path: dir.display().to_string(), action, source };
-    let staging = sibling(dir, "tmp");
-    let _ = std::fs::remove_dir_all(&staging);
-    let result = (|| {
-        std::fs::create_dir_all(&staging).map_err(|e| io("create", e))?;
+    let io = |source| StageError::Io { path: dir.display().to_string(), action: "write", source };
+    let fill = |staging: &Path| {
         let index = serde_json::to_string_pretty(&header).expect("the header serializes");
-        std::fs::write(staging.join(INDEX), index + "\n").map_err(|e| io("write", e))?;
+        std::fs::write(staging.join(INDEX), index + "\n").map_err(io)?;
         for (i, (primitive, named)) in vocabulary.primitives().iter().zip(&arrays).enumerate() {
             let get = |name: &str| &named.iter().find(|(n, _)| *n == name).expect("every array is named").1;
             let d = primitive.dims();
@@ -453,12 +451,9 @@ pub fn write_primitives(vocabulary: &Vocabulary, dir: &Path) -> Result<(), Stage
             field.set_meta("primitive", primitive.name().to_string());
             field.write(&staging.join(format!("p{i}.field.parquet")))?;
         }
-        replace_dir(&staging, dir).map_err(|e| io("write", e))
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_dir_all(&staging);
-    }
-    result
+        Ok(())
+    };
+    write_dir_atomic(dir, fill, io)
 }
 
 /// Reads a primitives folder back into a vocabulary.
@@ -518,24 +513,6 @@ pub fn read_primitives(dir: &Path) -> Result<Vocabulary, StageError> {
 fn read_exact(path: &Path, kind: &'static str, schema: &[(String, ColumnType)]) -> Result<Table, StageError> {
     let schema: Vec<(&str, ColumnType)> = schema.iter().map(|(n, t)| (n.as_str(), *t)).collect();
     Ok(Table::read(path, kind, &schema)?)
-}
-
-/// `dir` with a hidden sibling name: `.<name>.<what>.<pid>`.
-fn sibling(dir: &Path, what: &str) -> PathBuf {
-    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "primitives".into());
-    dir.with_file_name(format!(".{name}.{what}.{}", std::process::id()))
-}
-
-/// Puts the finished folder `staging` at `dir`, replacing what was there.
-fn replace_dir(staging: &Path, dir: &Path) -> std::io::Result<()> {
-    if dir.exists() {
-        let old = sibling(dir, "old");
-        std::fs::rename(dir, &old)?;
-        std::fs::rename(staging, dir)?;
-        std::fs::remove_dir_all(&old)
-    } else {
-        std::fs::rename(staging, dir)
-    }
 }
 
 /// The build settings a vocabulary records, from the lineage of its
