@@ -1,10 +1,12 @@
 //! `imitate`: learn a vocabulary of dynamical motion primitives from motion
 //! capture and use it to follow a person through one camera.
 //!
-//! The library follows the pipeline; this release holds its foundation,
-//! [`mocap`]: BVH reading and writing, the canonical humanoid, retargeting
-//! and the procedural demonstrator.
+//! The library follows the pipeline: [`mocap`] (BVH, the canonical
+//! humanoid, retargeting, the procedural demonstrator), [`vocab`] (learning
+//! a vocabulary of primitives) and [`vision`] (camera, the body drawn as
+//! capsules, distance transforms and the eq. 8–9 likelihood).
 
 pub mod fsutil;
 pub mod mocap;
+pub mod vision;
 pub mod vocab;

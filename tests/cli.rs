@@ -20,7 +20,7 @@ fn version_and_help_list_the_built_subcommands() {
     assert!(out.status.success());
     assert_eq!(stdout_of(&out).trim(), format!("imitate {}", env!("CARGO_PKG_VERSION")));
     let help = stdout_of(&imitate().arg("--help").output().unwrap());
-    let built = ["inspect", "retarget", "synth", "segment", "embed", "cluster", "fit", "export", "vocab"];
+    let built = ["inspect", "retarget", "synth", "segment", "embed", "cluster", "fit", "export", "vocab", "render"];
     for sub in built.iter().chain(&["--quiet"]) {
         assert!(help.contains(sub), "help lacks {sub}:\n{help}");
     }

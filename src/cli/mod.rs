@@ -9,6 +9,7 @@ mod export;
 mod fit;
 mod inspect;
 mod learn;
+mod render;
 mod retarget;
 mod segment;
 mod synth;
@@ -49,6 +50,7 @@ enum Command {
     Fit(fit::Args),
     Export(export::Args),
     Vocab(vocab::Args),
+    Render(render::Args),
 }
 
 /// How a command ended, when it did not fail outright.
@@ -75,6 +77,7 @@ pub fn main() -> ExitCode {
         Command::Fit(args) => fit::run(args, cli.global),
         Command::Export(args) => export::run(args, cli.global),
         Command::Vocab(args) => vocab::run(args, cli.global),
+        Command::Render(args) => render::run(args, cli.global),
     };
     match result {
         Ok(Outcome::Success) => ExitCode::SUCCESS,

@@ -120,7 +120,31 @@ pub struct Motion {
     pub poses: Vec<Pose>,
 }
 
+impl Pose {
+    /// The pose a fraction `t` of the way from `self` to `next`: the root
+    /// moved in a straight line, every joint turned the short way round
+    /// (spherical interpolation of its rotation).
+    pub fn interpolate(&self, next: &Pose, t: f64) -> Pose {
+        let rotations = Joint::ALL.map(|j| self.local_rotation(j).slerp(next.local_rotation(j), t));
+        Pose::from_rotations(self.root.lerp(next.root, t), &rotations)
+    }
+}
+
 impl Motion {
+    /// Duration, seconds: from the first frame to the last.
+    pub fn duration_s(&self) -> f64 {
+        self.poses.len().saturating_sub(1) as f64 * self.frame_time_s
+    }
+
+    /// The pose at `time_s` seconds after the first frame, between the
+    /// frames around it; held at the first and last frame outside them.
+    /// The motion must have a frame.
+    pub fn pose_at(&self, time_s: f64) -> Pose {
+        let last = self.poses.len() - 1;
+        let at = (time_s / self.frame_time_s).clamp(0.0, last as f64);
+        let i = (at.floor() as usize).min(last);
+        if i == last { self.poses[last] } else { self.poses[i].interpolate(&self.poses[i + 1], at - i as f64) }
+    }
     /// The BVH skeleton of `body`: 6 channels on the pelvis, three rotation
     /// channels on every other joint (hinges too, for importers that expect
     /// three), end sites on the head, hands and feet.
@@ -226,5 +250,35 @@ mod tests {
             assert!((frame.position(wrist) - frame.position(elbow)).z > 0.1);
         }
         assert!((frame.position(Joint::LeftAnkle) - frame.position(Joint::LeftKnee)).z < -0.1);
+    }
+
+    fn motion(poses: Vec<Pose>) -> Motion {
+        Motion { body: Body::standard(), frame_time_s: 0.1, poses }
+    }
+
+    #[test]
+    fn a_motion_between_frames_turns_each_joint_part_way_and_holds_its_ends() {
+        let body = Body::standard();
+        let mut a = Pose::rest(&body);
+        let mut b = a;
+        a.heading = 0.2;
+        b.heading = 0.6;
+        b.root.x += 1.0;
+        let elbow = Joint::LeftElbow.dof_offset();
+        b.x[elbow] = 1.0;
+        let shoulder = Joint::LeftShoulder.dof_offset();
+        b.x[shoulder + 2] = 0.8;
+        let m = motion(vec![a, b]);
+        let mid = m.pose_at(0.025);
+        assert!((mid.heading - 0.3).abs() < 1e-9, "{}", mid.heading);
+        assert!((mid.root.x - a.root.x - 0.25).abs() < 1e-12);
+        assert!((mid.x[elbow] - 0.25).abs() < 1e-9);
+        assert!((mid.x[shoulder + 2] - 0.2).abs() < 1e-9 && mid.x[shoulder].abs() < 1e-12);
+        assert_eq!(m.pose_at(-1.0), a);
+        assert_eq!(m.pose_at(5.0), b);
+        assert!((m.duration_s() - 0.1).abs() < 1e-15);
+        // At a frame's own time: that frame (up to conversion round-off).
+        let at = m.pose_at(0.1);
+        assert!(at.x.iter().zip(&b.x).all(|(p, q)| (p - q).abs() < 1e-12) && at.root == b.root);
     }
 }

@@ -1,0 +1,172 @@
+//! `imitate render`: test videos with ground truth, from any BVH.
+
+use super::retarget::{UpArg, options};
+use super::{Global, Outcome, UsageError, note, progress};
+use anyhow::{Context, bail};
+use image::ImageEncoder;
+use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+use imitate::fsutil::{write_atomic, write_dir_atomic};
+use imitate::mocap::pose::Motion;
+use imitate::vision::camera::{Camera, Preset};
+use imitate::vision::mask::Mask;
+use imitate::vision::render::draw;
+use imitate::vision::shape::capsules;
+use imitate::vision::truth;
+use imitate::vocab::corpus::{self, read_labels};
+use rayon::prelude::*;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Render a BVH take (any skeleton: it is retargeted first) as binary
+/// silhouettes of the canonical body drawn as capsules, with the camera and
+/// the ground truth of every frame.
+///
+/// Writes DIR/frames/000000.png … (0 outside the body, 255 on it),
+/// DIR/camera.json and DIR/truth.csv (see the README).
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The BVH file to render.
+    pub input: PathBuf,
+    /// The folder to write (refused if it exists and is not empty, unless
+    /// --force).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// `front`, `side`, `overhead`, or a camera.json file.
+    #[arg(long, default_value = "front", value_name = "PRESET|camera.json")]
+    pub camera: String,
+    /// Frame size, WIDTHxHEIGHT, for a preset camera (a camera.json
+    /// gives its own).
+    #[arg(long, default_value = "160x120", value_name = "WxH")]
+    pub size: String,
+    /// Frames per second of the video; the take is sampled at these
+    /// times, between its own frames where they fall between.
+    #[arg(long, default_value_t = 15.0)]
+    pub fps: f64,
+    /// Activity labels (as for `imitate segment`); truth.csv then names
+    /// each frame's activity.
+    #[arg(long, value_name = "LABELS.csv")]
+    pub labels: Option<PathBuf>,
+    /// The source's up axis, when detection from the skeleton gets it wrong.
+    #[arg(long, value_enum)]
+    pub up: Option<UpArg>,
+    /// A mapping file for joints the built-in naming tables do not know.
+    #[arg(long = "map", value_name = "MAPPING.toml")]
+    pub mapping: Option<PathBuf>,
+    /// Replace the output folder if it exists.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// `WIDTHxHEIGHT`.
+fn parse_size(text: &str) -> Result<(u32, u32), UsageError> {
+    let bad = || UsageError(format!("--size {text}: expected WIDTHxHEIGHT, e.g. 160x120"));
+    let (w, h) = text.split_once(['x', 'X']).ok_or_else(bad)?;
+    Ok((w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?))
+}
+
+fn camera(args: &Args) -> anyhow::Result<Camera> {
+    let (width, height) = parse_size(&args.size)?;
+    match Preset::from_name(&args.camera) {
+        Some(preset) => Camera::preset(preset, width, height).map_err(|e| UsageError(format!("--size: {e}")).into()),
+        None if Path::new(&args.camera).is_file() => Ok(Camera::read(Path::new(&args.camera))?),
+        None => Err(UsageError(format!(
+            "--camera {}: neither a preset (front, side, overhead) nor a camera.json file",
+            args.camera
+        ))
+        .into()),
+    }
+}
+
+/// The take and, when labelled, each of its frames' activity.
+fn take(args: &Args) -> anyhow::Result<(Motion, Option<Vec<String>>)> {
+    if args.input.is_dir() {
+        bail!("{}: is a folder; render takes one BVH file", args.input.display());
+    }
+    let labels = args.labels.as_deref().map(|p| read_labels(p).map(|l| (l, p.display().to_string()))).transpose()?;
+    let options = options(args.up, args.mapping.as_deref())?;
+    let mut corpus =
+        corpus::load(std::slice::from_ref(&args.input), &options, labels.as_ref().map(|(l, p)| (l, p.as_str())))?;
+    let recording = corpus.takes.pop().expect("one input gives one take");
+    let names = recording.labels.map(|ids| ids.iter().map(|&id| corpus.label(id).to_string()).collect());
+    Ok((recording.motion, names))
+}
+
+/// One frame as an 8-bit grey PNG: 0 outside, 255 on the body. Fast
+/// compression: binary frames compress well whatever the level.
+fn png(mask: &Mask) -> Vec<u8> {
+    let grey: Vec<u8> = mask.pixels().iter().map(|&p| p * 255).collect();
+    let mut out = Vec::with_capacity(grey.len() / 8);
+    PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Sub)
+        .write_image(&grey, mask.width() as u32, mask.height() as u32, image::ExtendedColorType::L8)
+        .expect("encoding to memory cannot fail");
+    out
+}
+
+pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
+    if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 1000.0) {
+        return Err(UsageError(format!("--fps {}: must be above 0 and at most 1000", args.fps)).into());
+    }
+    let camera = camera(&args)?;
+    let nonempty = args.output.read_dir().is_ok_and(|mut d| d.next().is_some());
+    if nonempty && !args.force {
+        bail!(
+            "{}: exists and is not empty; choose another folder or pass --force to replace it",
+            args.output.display()
+        );
+    }
+    let started = Instant::now();
+    let (motion, labels) = take(&args)?;
+    let times: Vec<f64> = (0..).map(|k| k as f64 / args.fps).take_while(|&t| t <= motion.duration_s() + 1e-9).collect();
+    let bar = progress(global, times.len() as u64, "render");
+    let output = args.output.display().to_string();
+    let io = |e: std::io::Error| anyhow::anyhow!("{output}: cannot write: {e}");
+    write_dir_atomic(
+        &args.output,
+        |dir| {
+            let frames = dir.join("frames");
+            std::fs::create_dir(&frames).map_err(io)?;
+            let rows: Vec<String> = times
+                .par_iter()
+                .enumerate()
+                .map_init(
+                    || Mask::new(camera.width(), camera.height()),
+                    |mask, (k, &t)| {
+                        let pose = motion.pose_at(t);
+                        mask.clear();
+                        draw(&camera, &capsules(&motion.body, &motion.body.forward(&pose)), mask);
+                        std::fs::write(frames.join(format!("{k:06}.png")), png(mask))?;
+                        bar.inc(1);
+                        let source = ((t / motion.frame_time_s).round() as usize).min(motion.poses.len() - 1);
+                        let activity = labels.as_ref().map(|l| l[source].as_str());
+                        Ok(truth::row(k, t, activity, &motion.body, &pose))
+                    },
+                )
+                .collect::<std::io::Result<_>>()
+                .map_err(io)?;
+            std::fs::write(dir.join("camera.json"), camera.to_json()).map_err(io)?;
+            write_atomic(&dir.join("truth.csv"), |w| {
+                w.write_all(truth::header().as_bytes())?;
+                rows.iter().try_for_each(|r| w.write_all(r.as_bytes()))
+            })
+            .map_err(io)
+        },
+        io,
+    )
+    .with_context(|| args.input.display().to_string())?;
+    bar.finish_and_clear();
+    let seconds = started.elapsed().as_secs_f64();
+    note(
+        global,
+        &format!(
+            "{}: {} frames at {} Hz, {}×{} → {output} in {seconds:.2} s ({:.0} frames/s)",
+            args.input.display(),
+            times.len(),
+            args.fps,
+            camera.width(),
+            camera.height(),
+            times.len() as f64 / seconds
+        ),
+    );
+    Ok(Outcome::Success)
+}

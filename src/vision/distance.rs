@@ -1,0 +1,559 @@
+//! Exact Euclidean distance transforms and the eq. 8–9 likelihood.
+//!
+//! The likelihood of a hypothesis silhouette A (the body as drawn) given the
+//! observed silhouette B is
+//!
+//! ```text
+//! R(A, B) = 1 / (r(A, B) + r(B, A) + ε),   r(A, B) = Σ_{a ∈ A} min_{b ∈ B} ‖a − b‖²
+//! ```
+//!
+//! over pixel centres, in pixels². The inner minimum is read from a squared
+//! Euclidean distance transform, so r(A, B) is one pass over A's pixels once
+//! B's transform is known. B's transform is built once per frame
+//! ([`Observation`]); A's is rebuilt for every hypothesis into a reused
+//! [`DistanceField`], which then allocates nothing.
+//!
+//! The transform is Felzenszwalb and Huttenlocher's ("Distance Transforms of
+//! Sampled Functions", 2012): a vertical pass gives every pixel the distance
+//! to the nearest set pixel in its column, then each row takes the lower
+//! envelope of the parabolas `g(q)² + (x − q)²` rooted at its pixels. Both
+//! passes are exact integer arithmetic.
+
+use super::mask::Mask;
+
+/// ε of eq. 8, in pixels². It only keeps R finite when A = B: every r is a
+/// whole number of pixels², so any mismatch costs at least 1 and, with ε = 1,
+/// a perfect match scores 1 and a one-pixel miss 1/2 rather than a spike that
+/// would swamp every other hypothesis.
+pub const EPSILON: f64 = 1.0;
+
+/// During the vertical pass: the column holds no set pixel.
+const NO_PIXEL: u32 = u32::MAX;
+
+/// The squared Euclidean distance, in pixels², from every pixel centre of a
+/// mask to the nearest set pixel's centre, row-major like the mask.
+///
+/// Values are `u32`: they are exact integers, at most (w − 1)² + (h − 1)²,
+/// and half the width of `f64` halves the memory the likelihood streams
+/// through; sums over them are taken in `u64`, still exact.
+///
+/// * A full mask has every distance 0.
+/// * An empty mask has no nearest pixel: its distance is infinite, which the
+///   field stands in for by w² + h² at every pixel — strictly more than any
+///   distance between two pixels of the image, so no real pixel is ever
+///   nearer than "none", yet finite, so r(A, ∅) = |A|·(w² + h²) and
+///   R(A, ∅) stay finite and still fall as A grows.
+///
+/// The field also keeps the buffers the transform works in, so
+/// [`compute_into`](Self::compute_into) allocates nothing once it has seen a
+/// mask of the same size.
+#[derive(Clone, Debug, Default)]
+pub struct DistanceField {
+    width: usize,
+    height: usize,
+    values: Vec<u32>,
+    /// The lower envelope of one row's parabolas, left to right.
+    envelope: Vec<Parabola>,
+}
+
+/// `g² + (x − apex)²`, stored as `lift = g² + apex²` so that comparing two
+/// parabolas at x needs only `lift − 2·x·apex` (the x² is common).
+#[derive(Clone, Copy, Debug)]
+struct Parabola {
+    apex: i64,
+    lift: i64,
+}
+
+impl DistanceField {
+    /// An empty (0 × 0) field, to be filled by [`compute_into`](Self::compute_into).
+    pub fn new() -> DistanceField {
+        DistanceField::default()
+    }
+
+    /// The distance field of `mask`.
+    pub fn of(mask: &Mask) -> DistanceField {
+        let mut field = DistanceField::new();
+        field.compute_into(mask);
+        field
+    }
+
+    /// Overwrites this field with the distance field of `mask`, reusing its
+    /// buffers.
+    ///
+    /// # Panics
+    /// If w² + h² does not fit in a `u32` (masks past ~46 000 pixels a side).
+    pub fn compute_into(&mut self, mask: &Mask) {
+        let (width, height) = (mask.width(), mask.height());
+        let absent = absent_distance(width, height);
+        self.width = width;
+        self.height = height;
+        self.values.resize(width * height, 0);
+        if width == 0 || height == 0 {
+            return;
+        }
+        self.vertical_pass(mask.pixels());
+        // After the vertical pass, a column holds a set pixel iff its top
+        // value is finite; with none anywhere, nothing is nearest.
+        if self.values[..width].iter().all(|&g| g == NO_PIXEL) {
+            self.values.fill(absent);
+            return;
+        }
+        self.envelope.reserve(width);
+        for row in self.values.chunks_exact_mut(width) {
+            horizontal_pass(row, &mut self.envelope);
+        }
+    }
+
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The squared distance at pixel (x, y).
+    pub fn get(&self, x: usize, y: usize) -> u32 {
+        assert!(x < self.width, "x = {x} outside a field {} wide", self.width);
+        self.values[y * self.width + x]
+    }
+
+    /// Every squared distance, row-major.
+    pub fn values(&self) -> &[u32] {
+        &self.values
+    }
+
+    /// Leaves in every pixel its distance (not squared) to the nearest set
+    /// pixel in its column, or `NO_PIXEL`. Both sweeps run a row at a time,
+    /// so the inner loops are contiguous and vectorise.
+    fn vertical_pass(&mut self, pixels: &[u8]) {
+        let width = self.width;
+        let mut rows = self.values.chunks_exact_mut(width).zip(pixels.chunks_exact(width));
+        let Some((first, first_pixels)) = rows.next() else { return };
+        for (g, &p) in first.iter_mut().zip(first_pixels) {
+            *g = if p != 0 { 0 } else { NO_PIXEL };
+        }
+        // Down: the nearest set pixel at or above.
+        let mut above: &[u32] = first;
+        for (row, row_pixels) in rows {
+            for ((g, &up), &p) in row.iter_mut().zip(above).zip(row_pixels) {
+                *g = if p != 0 { 0 } else { up.saturating_add(1) };
+            }
+            above = row;
+        }
+        // Up: or below, whichever is nearer.
+        let mut rows = self.values.chunks_exact_mut(width).rev();
+        let Some(last) = rows.next() else { return };
+        let mut below: &[u32] = last;
+        for row in rows {
+            for (g, &down) in row.iter_mut().zip(below) {
+                *g = (*g).min(down.saturating_add(1));
+            }
+            below = row;
+        }
+    }
+}
+
+/// Turns one row of vertical distances `g` into squared distances:
+/// `d(x) = min_q g(q)² + (x − q)²` over the columns q that hold a set pixel
+/// (at least one does, or the mask was empty).
+fn horizontal_pass(row: &mut [u32], envelope: &mut Vec<Parabola>) {
+    envelope.clear();
+    for (q, &g) in row.iter().enumerate() {
+        if g == NO_PIXEL {
+            continue;
+        }
+        let (apex, g) = (q as i64, i64::from(g));
+        let next = Parabola { apex, lift: g * g + apex * apex };
+        // `last` covers no x once `next` undercuts it no later than `last`
+        // undercut `before`. The crossing of parabolas a < b is at
+        // x = (b.lift − a.lift) / 2(b.apex − a.apex); cross-multiplying the
+        // two crossings keeps the test exact and free of division.
+        while let [.., before, last] = envelope[..] {
+            let next_crosses = (next.lift - last.lift) * (last.apex - before.apex);
+            let last_crossed = (last.lift - before.lift) * (next.apex - last.apex);
+            if next_crosses > last_crossed {
+                break;
+            }
+            envelope.pop();
+        }
+        envelope.push(next);
+    }
+    // The crossings now rise left to right, so the lowest parabola at x is
+    // found by moving right while the next one is at least as low.
+    let mut k = 0;
+    let mut lowest = envelope[0];
+    for (x, d) in row.iter_mut().enumerate() {
+        let x = x as i64;
+        while let Some(&next) = envelope.get(k + 1) {
+            if next.lift - 2 * x * next.apex > lowest.lift - 2 * x * lowest.apex {
+                break;
+            }
+            k += 1;
+            lowest = next;
+        }
+        // Exact and below (w − 1)² + (h − 1)², which fits a u32.
+        *d = (lowest.lift - 2 * x * lowest.apex + x * x) as u32;
+    }
+}
+
+/// The stand-in for "no nearest pixel" in a w × h image: w² + h², beyond
+/// every in-image squared distance.
+fn absent_distance(width: usize, height: usize) -> u32 {
+    width
+        .checked_mul(width)
+        .zip(height.checked_mul(height))
+        .and_then(|(w2, h2)| w2.checked_add(h2))
+        .and_then(|d| u32::try_from(d).ok())
+        .unwrap_or_else(|| panic!("a {width} × {height} mask is too large for a u32 distance field"))
+}
+
+/// r(A, B) of eq. 9: the sum, over A's set pixels, of the squared distance to
+/// the nearest pixel of B, read from B's distance field. An empty A costs 0;
+/// an empty B costs |A|·(w² + h²) (see [`DistanceField`]).
+///
+/// # Panics
+/// If `a` and `b` differ in size.
+pub fn directed_cost(a: &Mask, b: &DistanceField) -> u64 {
+    assert_eq!((a.width(), a.height()), (b.width, b.height), "mask and distance field differ in size");
+    // Pixels are 0 or 1, so multiplying selects without a branch.
+    a.pixels().iter().zip(&b.values).map(|(&p, &d)| u64::from(p) * u64::from(d)).sum()
+}
+
+/// One frame's observed silhouette B with its distance field, built once and
+/// then asked for the likelihood of many hypotheses.
+#[derive(Clone, Debug)]
+pub struct Observation {
+    mask: Mask,
+    field: DistanceField,
+    epsilon: f64,
+}
+
+impl Observation {
+    /// The observation of silhouette `mask`, with ε = [`EPSILON`].
+    pub fn new(mask: Mask) -> Observation {
+        Observation::with_epsilon(mask, EPSILON)
+    }
+
+    /// The observation of silhouette `mask`, with ε = `epsilon` pixels².
+    ///
+    /// # Panics
+    /// Unless `epsilon` is finite and positive (R would be infinite or NaN).
+    pub fn with_epsilon(mask: Mask, epsilon: f64) -> Observation {
+        assert!(epsilon.is_finite() && epsilon > 0.0, "ε must be finite and positive, not {epsilon}");
+        let field = DistanceField::of(&mask);
+        Observation { mask, field, epsilon }
+    }
+
+    pub fn mask(&self) -> &Mask {
+        &self.mask
+    }
+
+    pub fn field(&self) -> &DistanceField {
+        &self.field
+    }
+
+    pub fn epsilon(&self) -> f64 {
+        self.epsilon
+    }
+
+    /// (r(A, B), r(B, A)) for hypothesis A. Leaves A's distance field in
+    /// `scratch`, whose buffers are reused.
+    ///
+    /// # Panics
+    /// If `hypothesis` differs in size from the observed mask.
+    pub fn costs(&self, hypothesis: &Mask, scratch: &mut DistanceField) -> (u64, u64) {
+        let forward = directed_cost(hypothesis, &self.field);
+        scratch.compute_into(hypothesis);
+        (forward, directed_cost(&self.mask, scratch))
+    }
+
+    /// R(A, B) of eq. 8 for hypothesis A, in (0, 1/ε]: 1/ε exactly when A = B
+    /// (including both empty), finite always. `scratch` is overwritten with
+    /// A's distance field.
+    ///
+    /// # Panics
+    /// If `hypothesis` differs in size from the observed mask.
+    pub fn likelihood(&self, hypothesis: &Mask, scratch: &mut DistanceField) -> f64 {
+        let (forward, backward) = self.costs(hypothesis, scratch);
+        // Summed as integers first, so R(A, B) and R(B, A) are the same f64;
+        // exact in f64 for any image below ~10⁵ pixels a side.
+        1.0 / ((forward + backward) as f64 + self.epsilon)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// The squared distance from (x, y) to the nearest set pixel, by trying
+    /// them all; `None` for an empty mask.
+    fn nearest_by_brute_force(mask: &Mask, x: usize, y: usize) -> Option<u32> {
+        let (w, h) = (mask.width(), mask.height());
+        (0..h)
+            .flat_map(|by| (0..w).map(move |bx| (bx, by)))
+            .filter(|&(bx, by)| mask.get(bx, by))
+            .map(|(bx, by)| (bx.abs_diff(x).pow(2) + by.abs_diff(y).pow(2)) as u32)
+            .min()
+    }
+
+    fn field_by_brute_force(mask: &Mask) -> Vec<u32> {
+        let absent = (mask.width().pow(2) + mask.height().pow(2)) as u32;
+        (0..mask.height())
+            .flat_map(|y| (0..mask.width()).map(move |x| (x, y)))
+            .map(|(x, y)| nearest_by_brute_force(mask, x, y).unwrap_or(absent))
+            .collect()
+    }
+
+    fn cost_by_brute_force(a: &Mask, b: &Mask) -> u64 {
+        let b_field = field_by_brute_force(b);
+        (0..a.height())
+            .flat_map(|y| (0..a.width()).map(move |x| (x, y)))
+            .filter(|&(x, y)| a.get(x, y))
+            .map(|(x, y)| u64::from(b_field[y * a.width() + x]))
+            .sum()
+    }
+
+    /// A w × h mask with each pixel set with probability `density`.
+    fn random_mask(rng: &mut ChaCha8Rng, width: usize, height: usize, density: f64) -> Mask {
+        let mut mask = Mask::new(width, height);
+        for y in 0..height {
+            for x in 0..width {
+                mask.set(x, y, rng.gen_bool(density));
+            }
+        }
+        mask
+    }
+
+    /// Masks up to 24 × 24 (1 × 1, 1 × n and n × 1 included), anywhere from
+    /// empty through a lone pixel to full.
+    fn masks() -> impl Strategy<Value = Mask> {
+        let density = prop_oneof![Just(0u32), Just(100), 0u32..=5, 0u32..=100];
+        (1usize..=24, 1usize..=24, density).prop_flat_map(|(w, h, density)| {
+            proptest::collection::vec(0u32..100, w * h).prop_map(move |draws| {
+                let mut mask = Mask::new(w, h);
+                for (i, draw) in draws.into_iter().enumerate() {
+                    mask.set(i % w, i / w, draw < density);
+                }
+                mask
+            })
+        })
+    }
+
+    /// Runs `test` on cases from `strategy` with a fixed seed, so a failure
+    /// reproduces.
+    fn check<S: Strategy>(strategy: S, test: impl Fn(S::Value) -> Result<(), TestCaseError>) {
+        let config = Config { cases: 512, failure_persistence: None, ..Config::default() };
+        let rng = TestRng::from_seed(RngAlgorithm::ChaCha, &[7; 32]);
+        if let Err(e) = TestRunner::new_with_rng(config, rng).run(&strategy, test) {
+            panic!("{e}");
+        }
+    }
+
+    #[test]
+    fn transform_matches_brute_force_on_every_mask_of_at_most_16_pixels() {
+        let mut field = DistanceField::new();
+        for (w, h) in (1..=16).flat_map(|w| (1..=16 / w).map(move |h| (w, h))) {
+            for bits in 0u32..1 << (w * h) {
+                let mask = Mask::from_fn(w, h, |x, y| bits >> (y * w + x) & 1 != 0);
+                field.compute_into(&mask);
+                assert_eq!(field.values(), field_by_brute_force(&mask), "{w} × {h}, bits {bits:b}");
+            }
+        }
+    }
+
+    #[test]
+    fn transform_matches_brute_force_on_random_masks() {
+        check(masks(), |mask| {
+            let field = DistanceField::of(&mask);
+            prop_assert_eq!((field.width(), field.height()), (mask.width(), mask.height()));
+            prop_assert_eq!(field.values(), field_by_brute_force(&mask));
+            Ok(())
+        });
+    }
+
+    #[test]
+    fn transform_matches_brute_force_on_sparse_masks_up_to_80_by_60() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut field = DistanceField::new();
+        for _ in 0..40 {
+            let (w, h) = (rng.gen_range(1..=80), rng.gen_range(1..=60));
+            let pixels = rng.gen_range(1..=4);
+            let mut mask = Mask::new(w, h);
+            for _ in 0..pixels {
+                mask.set(rng.gen_range(0..w), rng.gen_range(0..h), true);
+            }
+            field.compute_into(&mask);
+            assert_eq!(field.values(), field_by_brute_force(&mask), "{w} × {h}");
+        }
+    }
+
+    #[test]
+    fn reused_field_matches_a_fresh_one_across_sizes() {
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let mut reused = DistanceField::new();
+        for &(w, h) in &[(30, 20), (1, 1), (50, 3), (0, 4), (3, 50), (30, 20)] {
+            let mask = random_mask(&mut rng, w, h, 0.1);
+            reused.compute_into(&mask);
+            let fresh = DistanceField::of(&mask);
+            assert_eq!((reused.width(), reused.height()), (w, h));
+            assert_eq!(reused.values(), fresh.values());
+        }
+    }
+
+    #[test]
+    fn lone_pixel_field_is_squared_distance_from_it() {
+        let field = DistanceField::of(&Mask::from_fn(5, 1, |x, _| x == 0));
+        assert_eq!(field.values(), &[0, 1, 4, 9, 16]);
+        let field = DistanceField::of(&Mask::from_fn(3, 3, |x, y| (x, y) == (1, 1)));
+        assert_eq!(field.values(), &[2, 1, 2, 1, 0, 1, 2, 1, 2]);
+        assert_eq!(DistanceField::of(&Mask::from_fn(7, 9, |x, y| (x, y) == (6, 8))).get(0, 0), 36 + 64);
+    }
+
+    #[test]
+    fn full_mask_field_is_zero_everywhere() {
+        for (w, h) in [(1, 1), (1, 9), (9, 1), (16, 12)] {
+            assert!(DistanceField::of(&Mask::from_fn(w, h, |_, _| true)).values().iter().all(|&d| d == 0));
+        }
+    }
+
+    #[test]
+    fn empty_mask_field_is_squared_image_diagonal_beyond_every_real_distance() {
+        for (w, h) in [(1, 1), (1, 9), (9, 1), (16, 12)] {
+            let field = DistanceField::of(&Mask::new(w, h));
+            let absent = (w * w + h * h) as u32;
+            assert!(field.values().iter().all(|&d| d == absent));
+            let farthest = ((w - 1).pow(2) + (h - 1).pow(2)) as u32;
+            assert!(absent > farthest);
+        }
+    }
+
+    #[test]
+    fn zero_sized_mask_has_an_empty_field_and_zero_cost() {
+        for (w, h) in [(0, 0), (0, 5), (5, 0)] {
+            let mask = Mask::new(w, h);
+            let field = DistanceField::of(&mask);
+            assert!(field.values().is_empty());
+            assert_eq!(directed_cost(&mask, &field), 0);
+            assert_eq!(Observation::new(mask.clone()).likelihood(&mask, &mut DistanceField::new()), 1.0 / EPSILON);
+        }
+    }
+
+    #[test]
+    fn directed_cost_matches_brute_force_on_random_pairs() {
+        let pairs = masks().prop_flat_map(|a| {
+            let (w, h) = (a.width(), a.height());
+            (Just(a), proptest::collection::vec(0u32..100, w * h), prop_oneof![Just(0u32), 0u32..=5, 0u32..=100])
+                .prop_map(move |(a, draws, density)| {
+                    let b = Mask::from_fn(w, h, |x, y| draws[y * w + x] < density);
+                    (a, b)
+                })
+        });
+        check(pairs, |(a, b)| {
+            prop_assert_eq!(directed_cost(&a, &DistanceField::of(&b)), cost_by_brute_force(&a, &b));
+            prop_assert_eq!(directed_cost(&b, &DistanceField::of(&a)), cost_by_brute_force(&b, &a));
+            Ok(())
+        });
+    }
+
+    #[test]
+    fn likelihood_of_small_cases_matches_hand_computation() {
+        let pixel = |w, h, px, py| Mask::from_fn(w, h, move |x, y| (x, y) == (px, py));
+        let mut scratch = DistanceField::new();
+        let likelihood =
+            |a: &Mask, b: &Mask, scratch: &mut DistanceField| Observation::new(b.clone()).likelihood(a, scratch);
+        // Same lone pixel: both sums are empty of cost.
+        assert_eq!(likelihood(&pixel(5, 5, 2, 2), &pixel(5, 5, 2, 2), &mut scratch), 1.0);
+        // Pixels 3-4-5 apart: 25 each way.
+        assert_eq!(likelihood(&pixel(5, 5, 0, 0), &pixel(5, 5, 3, 4), &mut scratch), 1.0 / 51.0);
+        // A = {(0,0), (1,0)}, B = {(0,0)}: r(A, B) = 0 + 1, r(B, A) = 0.
+        let pair = Mask::from_fn(5, 5, |x, y| y == 0 && x < 2);
+        assert_eq!(likelihood(&pair, &pixel(5, 5, 0, 0), &mut scratch), 1.0 / 2.0);
+        // A = row 0 of 3 × 2, B = {(2, 1)}: r(A, B) = 5 + 2 + 1, r(B, A) = 1.
+        let row = Mask::from_fn(3, 2, |_, y| y == 0);
+        assert_eq!(Observation::new(pixel(3, 2, 2, 1)).costs(&row, &mut scratch), (8, 1));
+        assert_eq!(likelihood(&row, &pixel(3, 2, 2, 1), &mut scratch), 1.0 / 10.0);
+        // Empty A against B = {(0,0)} in 3 × 2: r(A, B) = 0, r(B, ∅) = 3² + 2².
+        assert_eq!(likelihood(&Mask::new(3, 2), &pixel(3, 2, 0, 0), &mut scratch), 1.0 / 14.0);
+        // Both empty: A = B.
+        assert_eq!(likelihood(&Mask::new(3, 2), &Mask::new(3, 2), &mut scratch), 1.0);
+        // A chosen ε takes the place of 1.
+        let observation = Observation::with_epsilon(pixel(5, 5, 3, 4), 0.5);
+        assert_eq!(observation.likelihood(&pixel(5, 5, 0, 0), &mut scratch), 1.0 / 50.5);
+    }
+
+    #[test]
+    fn likelihood_is_symmetric_and_finite() {
+        let pairs = masks().prop_flat_map(|a| {
+            let (w, h) = (a.width(), a.height());
+            (Just(a), proptest::collection::vec(0u32..100, w * h), 0u32..=100).prop_map(move |(a, draws, density)| {
+                let b = Mask::from_fn(w, h, |x, y| draws[y * w + x] < density);
+                (a, b)
+            })
+        });
+        check(pairs, |(a, b)| {
+            let mut scratch = DistanceField::new();
+            let ab = Observation::new(b.clone()).likelihood(&a, &mut scratch);
+            let ba = Observation::new(a.clone()).likelihood(&b, &mut scratch);
+            prop_assert_eq!(ab, ba);
+            prop_assert!(ab.is_finite() && ab > 0.0 && ab <= 1.0 / EPSILON);
+            Ok(())
+        });
+    }
+
+    #[test]
+    fn likelihood_is_highest_when_hypothesis_equals_observation() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut scratch = DistanceField::new();
+        for _ in 0..200 {
+            let (w, h) = (rng.gen_range(1..=40), rng.gen_range(1..=30));
+            let density = [0.0, 0.02, 0.3, 0.9, 1.0][rng.gen_range(0..5)];
+            let observed = random_mask(&mut rng, w, h, density);
+            let observation = Observation::new(observed.clone());
+            let best = observation.likelihood(&observed, &mut scratch);
+            assert_eq!(best, 1.0 / EPSILON);
+            for _ in 0..10 {
+                // Flip a few pixels, or shift the whole silhouette by one.
+                let mut perturbed = observed.clone();
+                if rng.gen_bool(0.5) {
+                    for _ in 0..rng.gen_range(1..=3) {
+                        let (x, y) = (rng.gen_range(0..w), rng.gen_range(0..h));
+                        perturbed.set(x, y, !perturbed.get(x, y));
+                    }
+                } else {
+                    let (dx, dy) = [(1, 0), (0, 1), (-1, 0), (0, -1)][rng.gen_range(0..4)];
+                    perturbed = Mask::from_fn(w, h, |x, y| {
+                        let (sx, sy) = (x as isize - dx, y as isize - dy);
+                        sx >= 0
+                            && sy >= 0
+                            && (sx as usize) < w
+                            && (sy as usize) < h
+                            && observed.get(sx as usize, sy as usize)
+                    });
+                }
+                let score = observation.likelihood(&perturbed, &mut scratch);
+                if perturbed == observed {
+                    assert_eq!(score, best);
+                } else {
+                    assert!(score < best, "{w} × {h}: perturbed scores {score}, exact match {best}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "differ in size")]
+    fn likelihood_rejects_a_hypothesis_of_another_size() {
+        Observation::new(Mask::new(4, 3)).likelihood(&Mask::new(3, 4), &mut DistanceField::new());
+    }
+
+    #[test]
+    #[should_panic(expected = "finite and positive")]
+    fn observation_rejects_zero_epsilon() {
+        Observation::with_epsilon(Mask::new(4, 3), 0.0);
+    }
+}

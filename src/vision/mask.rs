@@ -1,0 +1,77 @@
+//! Binary images: an observed silhouette, or a body drawn by the renderer.
+
+/// A binary image, row-major from the top-left pixel: which pixels belong to
+/// the person (or to the body drawn). Each pixel is one byte, 0 or 1, so
+/// rows can be scanned and summed without unpacking bits.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Mask {
+    width: usize,
+    height: usize,
+    pixels: Vec<u8>,
+}
+
+impl Mask {
+    /// An empty mask (no pixel set).
+    pub fn new(width: usize, height: usize) -> Mask {
+        Mask { width, height, pixels: vec![0; width * height] }
+    }
+
+    /// A mask whose pixel (x, y) is `inside(x, y)`.
+    pub fn from_fn(width: usize, height: usize, inside: impl Fn(usize, usize) -> bool) -> Mask {
+        let pixels = (0..height).flat_map(|y| (0..width).map(move |x| (x, y))).map(|(x, y)| u8::from(inside(x, y)));
+        Mask { width, height, pixels: pixels.collect() }
+    }
+
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    pub fn get(&self, x: usize, y: usize) -> bool {
+        self.pixels[y * self.width + x] != 0
+    }
+
+    pub fn set(&mut self, x: usize, y: usize, inside: bool) {
+        self.pixels[y * self.width + x] = u8::from(inside);
+    }
+
+    /// Every pixel, row-major, 0 or 1.
+    pub fn pixels(&self) -> &[u8] {
+        &self.pixels
+    }
+
+    /// Sets every pixel of row `y` from `x0` to `x1` (exclusive) inside.
+    pub fn fill_span(&mut self, y: usize, x0: usize, x1: usize) {
+        let row = y * self.width;
+        self.pixels[row + x0..row + x1].fill(1);
+    }
+
+    /// Clears every pixel, keeping the size (and the allocation).
+    pub fn clear(&mut self) {
+        self.pixels.fill(0);
+    }
+
+    /// How many pixels are set.
+    pub fn count(&self) -> usize {
+        self.pixels.iter().map(|&p| p as usize).sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pixels_are_row_major_from_the_top_left() {
+        let mut m = Mask::from_fn(4, 3, |x, y| x == 3 && y == 0);
+        assert_eq!(m.pixels(), &[0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0]);
+        m.fill_span(2, 1, 3);
+        assert!(m.get(1, 2) && m.get(2, 2) && !m.get(3, 2) && !m.get(0, 2));
+        assert_eq!(m.count(), 3);
+        m.clear();
+        assert_eq!((m.count(), m.width(), m.height()), (0, 4, 3));
+    }
+}

@@ -1,0 +1,9 @@
+//! What the tracker sees: a camera, the body drawn as capsules, silhouettes
+//! from frames, and the likelihood of a pose given a silhouette (eq. 8–9).
+
+pub mod camera;
+pub mod distance;
+pub mod mask;
+pub mod render;
+pub mod shape;
+pub mod truth;

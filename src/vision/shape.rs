@@ -1,0 +1,98 @@
+//! The body as the camera sees it: one capsule (a cylinder with rounded
+//! ends) per bone, sized from the body's height.
+
+use crate::mocap::body::{Body, Joint};
+use crate::mocap::pose::BodyFrame;
+use glam::DVec3;
+
+/// A segment from `a` to `b` swept by a sphere of `radius`, world meters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Capsule {
+    pub a: DVec3,
+    pub b: DVec3,
+    pub radius: f64,
+}
+
+/// Where a capsule runs: from a joint to another joint, or to the end of
+/// the bone leaving a joint (head top, hand tip, toe).
+#[derive(Clone, Copy, Debug)]
+enum Span {
+    Joints(Joint, Joint),
+    Bone(Joint),
+}
+
+/// Every capsule and its radius as a share of standing height. Radii are
+/// half the typical breadth of each part for an adult (anthropometric
+/// tables give head breadth ≈ 0.087 H, thigh ≈ 0.09 H, upper arm
+/// ≈ 0.055 H, …); the trunk is two capsules, hip to shoulder on each side,
+/// so it is broad seen from the front and shallow from the side.
+const PARTS: [(Span, f64); 16] = {
+    use Joint::*;
+    [
+        (Span::Bone(Head), 0.050),
+        (Span::Joints(Neck, Head), 0.030),
+        (Span::Joints(LeftHip, LeftShoulder), 0.055),
+        (Span::Joints(RightHip, RightShoulder), 0.055),
+        (Span::Joints(LeftShoulder, LeftElbow), 0.027),
+        (Span::Joints(RightShoulder, RightElbow), 0.027),
+        (Span::Joints(LeftElbow, LeftWrist), 0.021),
+        (Span::Joints(RightElbow, RightWrist), 0.021),
+        (Span::Bone(LeftWrist), 0.017),
+        (Span::Bone(RightWrist), 0.017),
+        (Span::Joints(LeftHip, LeftKnee), 0.042),
+        (Span::Joints(RightHip, RightKnee), 0.042),
+        (Span::Joints(LeftKnee, LeftAnkle), 0.029),
+        (Span::Joints(RightKnee, RightAnkle), 0.029),
+        (Span::Bone(LeftAnkle), 0.020),
+        (Span::Bone(RightAnkle), 0.020),
+    ]
+};
+
+/// How many capsules a body is drawn with.
+pub const CAPSULES: usize = PARTS.len();
+
+/// The body's capsules in a posed frame.
+pub fn capsules(body: &Body, frame: &BodyFrame) -> [Capsule; CAPSULES] {
+    let height = body.proportions.height_m;
+    let place = |(span, share): (Span, f64)| {
+        let (a, b) = match span {
+            Span::Joints(from, to) => (frame.position(from), frame.position(to)),
+            // The rounded end reaches the end site (head top, finger or
+            // toe tip) rather than passing it by a radius.
+            Span::Bone(j) => {
+                let (a, end) = (frame.position(j), frame.bone_end(body, j));
+                (a, end - (end - a).normalize_or_zero() * (share * height).min((end - a).length()))
+            }
+        };
+        Capsule { a, b, radius: share * height }
+    };
+    PARTS.map(place)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mocap::pose::Pose;
+
+    #[test]
+    fn a_t_pose_body_is_as_tall_and_as_wide_as_the_skeleton_and_its_limbs_thinner_than_its_trunk() {
+        for height in [1.5, 1.75, 2.0] {
+            let body = Body::new(crate::mocap::body::Proportions { height_m: height, ..Default::default() });
+            let parts = capsules(&body, &body.forward(&Pose::rest(&body)));
+            let reach = |f: &dyn Fn(DVec3) -> f64| {
+                parts.iter().flat_map(|c| [f(c.a) + c.radius, f(c.b) + c.radius]).fold(f64::MIN, f64::max)
+            };
+            let top = reach(&|p| p.y);
+            let bottom = -reach(&|p| -p.y);
+            let span = reach(&|p| p.x) + reach(&|p| -p.x);
+            let frame = body.forward(&Pose::rest(&body));
+            let head_top = frame.bone_end(&body, Joint::Head).y;
+            let tips = frame.bone_end(&body, Joint::LeftWrist).x - frame.bone_end(&body, Joint::RightWrist).x;
+            assert!((top - head_top).abs() < 1e-9, "{height}: top {top}, head top {head_top}");
+            assert!(bottom > -0.03 * height && bottom < 0.0, "{height}: the feet reach {bottom}");
+            assert!((span - tips).abs() < 0.04 * height, "{height}: span {span}, finger tips {tips}");
+        }
+        let trunk = PARTS.iter().find(|p| matches!(p.0, Span::Joints(Joint::LeftHip, _))).unwrap().1;
+        assert!(PARTS.iter().all(|p| p.1 <= trunk));
+    }
+}
