@@ -1,7 +1,7 @@
 //! `imitate inspect`: what a BVH file holds and how it maps onto the
 //! canonical body.
 
-use super::retarget::{UpArg, options};
+use super::retarget::RetargetArgs;
 use super::{Global, Outcome, peak_resident_mb, write_stdout};
 use imitate::mocap::bvh::{Bvh, Channel, Warning, read_bvh};
 use imitate::mocap::retarget::{Analysis, RetargetOptions, Retargeter};
@@ -26,12 +26,8 @@ pub struct Args {
     /// peak resident memory beside the size of the decoded values.
     #[arg(long)]
     pub timing: bool,
-    /// The source's up axis, when detection from the skeleton gets it wrong.
-    #[arg(long, value_enum)]
-    pub up: Option<UpArg>,
-    /// A mapping file for joints the built-in naming tables do not know.
-    #[arg(long = "map", value_name = "MAPPING.toml")]
-    pub mapping: Option<PathBuf>,
+    #[command(flatten)]
+    pub retarget: RetargetArgs,
 }
 
 /// Everything `inspect` says about one file; printed as text or JSON.
@@ -84,7 +80,7 @@ struct Timing {
 }
 
 pub fn run(args: Args, _global: Global) -> anyhow::Result<Outcome> {
-    let options = options(args.up, args.mapping.as_deref())?;
+    let options = args.retarget.options()?;
     let reports: Vec<Report> = args.files.iter().map(|f| inspect(f, &options, args.timing)).collect();
     let mut text = String::new();
     if args.json {

@@ -2,13 +2,12 @@
 //! `cluster`, `fit`) and `vocab build`, which runs them all.
 
 use super::UsageError;
-use super::retarget::UpArg;
+use super::retarget::RetargetArgs;
 use imitate::vocab::cluster::{ClusterParams, ValidClusterParams};
 use imitate::vocab::eigen::EigenMethod;
 use imitate::vocab::embed::{EmbedParams, ValidEmbedParams};
 use imitate::vocab::primitive::{FitParams, ValidFitParams};
 use imitate::vocab::segment::{Method, SegmentParams, ValidSegmentParams};
-use imitate::vocab::stages::RetargetSettings;
 use std::path::PathBuf;
 
 /// The takes a learning command reads, their labels, and how they are put
@@ -23,18 +22,8 @@ pub struct TakesArgs {
     /// one take (as `synth --sequence` writes) or `file,frame,activity`.
     #[arg(long, value_name = "LABELS.csv")]
     pub labels: Option<PathBuf>,
-    /// The sources' up axis, when detection from the skeleton gets it wrong.
-    #[arg(long, value_enum)]
-    pub up: Option<UpArg>,
-    /// A mapping file for joints the built-in naming tables do not know.
-    #[arg(long = "map", value_name = "MAPPING.toml")]
-    pub mapping: Option<PathBuf>,
-}
-
-impl TakesArgs {
-    pub fn settings(&self) -> RetargetSettings {
-        RetargetSettings::new(self.up.map(Into::into), self.mapping.as_deref())
-    }
+    #[command(flatten)]
+    pub retarget: RetargetArgs,
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]

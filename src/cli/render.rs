@@ -1,6 +1,7 @@
 //! `imitate render`: test videos with ground truth, from any BVH.
 
-use super::retarget::{UpArg, options};
+use super::retarget::RetargetArgs;
+use super::segment::load_corpus;
 use super::{Global, Outcome, UsageError, note, progress};
 use anyhow::{Context, bail};
 use image::ImageEncoder;
@@ -12,7 +13,6 @@ use imitate::vision::mask::Mask;
 use imitate::vision::render::draw;
 use imitate::vision::shape::capsules;
 use imitate::vision::truth;
-use imitate::vocab::corpus::{self, read_labels};
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -47,12 +47,8 @@ pub struct Args {
     /// each frame's activity.
     #[arg(long, value_name = "LABELS.csv")]
     pub labels: Option<PathBuf>,
-    /// The source's up axis, when detection from the skeleton gets it wrong.
-    #[arg(long, value_enum)]
-    pub up: Option<UpArg>,
-    /// A mapping file for joints the built-in naming tables do not know.
-    #[arg(long = "map", value_name = "MAPPING.toml")]
-    pub mapping: Option<PathBuf>,
+    #[command(flatten)]
+    pub retarget: RetargetArgs,
     /// Replace the output folder if it exists.
     #[arg(long)]
     pub force: bool,
@@ -79,14 +75,12 @@ fn camera(args: &Args) -> anyhow::Result<Camera> {
 }
 
 /// The take and, when labelled, each of its frames' activity.
-fn take(args: &Args) -> anyhow::Result<(Motion, Option<Vec<String>>)> {
+fn take(args: &Args, global: Global) -> anyhow::Result<(Motion, Option<Vec<String>>)> {
     if args.input.is_dir() {
         bail!("{}: is a folder; render takes one BVH file", args.input.display());
     }
-    let labels = args.labels.as_deref().map(|p| read_labels(p).map(|l| (l, p.display().to_string()))).transpose()?;
-    let options = options(args.up, args.mapping.as_deref())?;
-    let mut corpus =
-        corpus::load(std::slice::from_ref(&args.input), &options, labels.as_ref().map(|(l, p)| (l, p.as_str())))?;
+    let input = std::slice::from_ref(&args.input);
+    let mut corpus = load_corpus(input, args.labels.as_deref(), &args.retarget.options()?, global)?;
     let recording = corpus.takes.pop().expect("one input gives one take");
     let names = recording.labels.map(|ids| ids.iter().map(|&id| corpus.label(id).to_string()).collect());
     Ok((recording.motion, names))
@@ -116,7 +110,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         );
     }
     let started = Instant::now();
-    let (motion, labels) = take(&args)?;
+    let (motion, labels) = take(&args, global)?;
     let times: Vec<f64> = (0..).map(|k| k as f64 / args.fps).take_while(|&t| t <= motion.duration_s() + 1e-9).collect();
     let bar = progress(global, times.len() as u64, "render");
     let output = args.output.display().to_string();

@@ -6,7 +6,8 @@ use imitate::fsutil::write_atomic;
 use imitate::mocap::bvh::{read_bvh, write_bvh};
 use imitate::mocap::names::UserMapping;
 use imitate::mocap::retarget::{DirectionErrors, RetargetOptions, Retargeter, UpAxis};
-use std::path::{Path, PathBuf};
+use imitate::vocab::stages::RetargetSettings;
+use std::path::PathBuf;
 
 /// Retarget a BVH file onto the canonical 17-joint humanoid.
 ///
@@ -19,6 +20,14 @@ pub struct Args {
     /// Where to write the canonical BVH.
     #[arg(short, long)]
     pub output: PathBuf,
+    #[command(flatten)]
+    pub retarget: RetargetArgs,
+}
+
+/// How source skeletons are put onto the canonical body: what every
+/// command that reads BVH takes.
+#[derive(Debug, clap::Args)]
+pub struct RetargetArgs {
     /// The source's up axis, when detection from the skeleton gets it wrong.
     #[arg(long, value_enum)]
     pub up: Option<UpArg>,
@@ -26,6 +35,19 @@ pub struct Args {
     /// (`canonical = "Source Joint"`, see the README).
     #[arg(long = "map", value_name = "MAPPING.toml")]
     pub mapping: Option<PathBuf>,
+}
+
+impl RetargetArgs {
+    /// The options, the mapping file read.
+    pub fn options(&self) -> anyhow::Result<RetargetOptions> {
+        let mapping = self.mapping.as_deref().map(UserMapping::load).transpose()?;
+        Ok(RetargetOptions { up: self.up.map(Into::into), mapping })
+    }
+
+    /// The settings as stage files record them.
+    pub fn settings(&self) -> RetargetSettings {
+        RetargetSettings::new(self.up.map(Into::into), self.mapping.as_deref())
+    }
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -43,14 +65,8 @@ impl From<UpArg> for UpAxis {
     }
 }
 
-/// Reads the options shared with `inspect`.
-pub fn options(up: Option<UpArg>, mapping: Option<&Path>) -> anyhow::Result<RetargetOptions> {
-    let mapping = mapping.map(UserMapping::load).transpose()?;
-    Ok(RetargetOptions { up: up.map(Into::into), mapping })
-}
-
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
-    let options = options(args.up, args.mapping.as_deref())?;
+    let options = args.retarget.options()?;
     let bar = progress(global, 3, "retarget");
     let bvh = read_bvh(&args.input)?;
     bar.inc(1);

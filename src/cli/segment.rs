@@ -3,11 +3,12 @@
 use super::learn::{SegmentArgs, TakesArgs};
 use super::{Global, Outcome, count, note, progress};
 use anyhow::Context;
+use imitate::mocap::retarget::RetargetOptions;
 use imitate::vocab::corpus::{self, Corpus, read_labels};
 use imitate::vocab::pipeline::segment_corpus;
 use imitate::vocab::segment::ValidSegmentParams;
-use imitate::vocab::stages::{Lineage, RetargetSettings, Segments};
-use std::path::PathBuf;
+use imitate::vocab::stages::{Lineage, Segments};
+use std::path::{Path, PathBuf};
 
 /// Cut BVH takes into segments (one row per segment: file, frames,
 /// duration, whether it is a whole cycle, label).
@@ -24,12 +25,17 @@ pub struct Args {
     pub segment: SegmentArgs,
 }
 
-/// Reads and retargets the inputs, with their labels.
-pub fn load_corpus(takes: &TakesArgs, retarget: &RetargetSettings, global: Global) -> anyhow::Result<Corpus> {
-    let labels = takes.labels.as_deref();
+/// Reads and retargets the inputs (BVH files or folders), with their
+/// labels, warning of takes the labels leave out.
+pub fn load_corpus(
+    inputs: &[PathBuf],
+    labels: Option<&Path>,
+    options: &RetargetOptions,
+    global: Global,
+) -> anyhow::Result<Corpus> {
     let labels = labels.map(|path| read_labels(path).map(|l| (l, path.display().to_string()))).transpose()?;
     let bar = progress(global, 1, "read");
-    let corpus = corpus::load(&takes.inputs, &retarget.options()?, labels.as_ref().map(|(l, p)| (l, p.as_str())))?;
+    let corpus = corpus::load(inputs, options, labels.as_ref().map(|(l, p)| (l, p.as_str())))?;
     bar.finish_and_clear();
     if let Some((_, path)) = &labels {
         let unlabelled: Vec<&str> =
@@ -77,8 +83,8 @@ pub fn segment(
 
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let params = args.segment.params()?;
-    let settings = args.takes.settings();
-    let corpus = load_corpus(&args.takes, &settings, global)?;
+    let (takes, settings) = (&args.takes, args.takes.retarget.settings());
+    let corpus = load_corpus(&takes.inputs, takes.labels.as_deref(), &takes.retarget.options()?, global)?;
     let segments = segment(&corpus, &params, Lineage::new(settings, params.params().clone()), global)?;
     segments.write(&args.output)?;
     note(global, &format!("wrote {}", args.output.display()));

@@ -96,11 +96,12 @@ impl Stage {
 fn build(args: BuildArgs, global: Global) -> anyhow::Result<Outcome> {
     let (segment_params, embed_params) = (args.segment.params()?, args.embed.params()?);
     let (cluster_params, fit_params) = (args.cluster.params()?, args.fit.params()?);
-    let settings = args.takes.settings();
+    let (takes, settings) = (&args.takes, args.takes.retarget.settings());
     let mut times = Vec::new();
 
     let stage = Stage::start(global, "read");
-    let corpus = super::segment::load_corpus(&args.takes, &settings, global)?;
+    let options = takes.retarget.options()?;
+    let corpus = super::segment::load_corpus(&takes.inputs, takes.labels.as_deref(), &options, global)?;
     times.push(stage.finish());
     let stage = Stage::start(global, "segment");
     let lineage = Lineage::new(settings, segment_params.params().clone());

@@ -875,21 +875,14 @@ mod tests {
     }
 
     #[test]
-    fn parquet_round_trip_keeps_every_type_and_awkward_value_exactly() {
+    fn parquet_and_csv_round_trips_keep_every_type_and_awkward_value_exactly() {
         let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("segments.parquet");
-        let table = tricky();
-        table.write(&path).unwrap();
-        assert_same(&Table::read(&path, "segments", SEGMENTS).unwrap(), &table);
-    }
-
-    #[test]
-    fn csv_round_trip_keeps_every_type_and_awkward_value_exactly() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("segments.csv");
-        let table = tricky();
-        table.write(&path).unwrap();
-        assert_same(&Table::read(&path, "segments", SEGMENTS).unwrap(), &table);
+        for name in ["segments.parquet", "segments.csv"] {
+            let path = dir.path().join(name);
+            let table = tricky();
+            table.write(&path).unwrap();
+            assert_same(&Table::read(&path, "segments", SEGMENTS).unwrap(), &table);
+        }
     }
 
     #[test]
