@@ -127,13 +127,14 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
                     || Mask::new(camera.width(), camera.height()),
                     |mask, (k, &t)| {
                         let pose = motion.pose_at(t);
+                        let world = motion.body.forward(&pose);
                         mask.clear();
-                        draw(&camera, &capsules(&motion.body, &motion.body.forward(&pose)), mask);
+                        draw(&camera, &capsules(&motion.body, &world), mask);
                         std::fs::write(frames.join(format!("{k:06}.png")), png(mask))?;
                         bar.inc(1);
                         let source = ((t / motion.frame_time_s).round() as usize).min(motion.poses.len() - 1);
                         let activity = labels.as_ref().map(|l| l[source].as_str());
-                        Ok(truth::row(k, t, activity, &motion.body, &pose))
+                        Ok(truth::row(k, t, activity, &pose, &world))
                     },
                 )
                 .collect::<std::io::Result<_>>()

@@ -3,8 +3,8 @@
 //! canonical joint's world position and every joint angle. The tracker's
 //! `frames.csv` names its positions the same way, so the two line up.
 
-use crate::mocap::body::{Body, Joint, Kind};
-use crate::mocap::pose::Pose;
+use crate::mocap::body::{Joint, Kind};
+use crate::mocap::pose::{BodyFrame, Pose};
 use std::fmt::Write;
 
 /// `<joint>_x`, `<joint>_y`, `<joint>_z` for every canonical joint: world
@@ -35,11 +35,11 @@ pub fn header() -> String {
     columns.join(",") + "\n"
 }
 
-/// One frame's line. Numbers are written as the shortest decimals that
+/// One frame's line, from its pose and where that puts every joint
+/// (`Body::forward`). Numbers are written as the shortest decimals that
 /// read back to the same `f64`; an unknown activity is an empty field.
-pub fn row(frame: usize, time_s: f64, activity: Option<&str>, body: &Body, pose: &Pose) -> String {
+pub fn row(frame: usize, time_s: f64, activity: Option<&str>, pose: &Pose, world: &BodyFrame) -> String {
     let mut line = format!("{frame},{time_s},{}", activity.map(quoted).unwrap_or_default());
-    let world = body.forward(pose);
     let numbers = [pose.root.x, pose.root.y, pose.root.z, pose.heading]
         .into_iter()
         .chain(Joint::ALL.iter().flat_map(|&j| world.position(j).to_array()))
@@ -58,7 +58,7 @@ fn quoted(text: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mocap::body::DOF;
+    use crate::mocap::body::{Body, DOF};
 
     #[test]
     fn a_row_has_a_value_for_every_column_and_joint_positions_from_forward_kinematics() {
@@ -67,7 +67,7 @@ mod tests {
         pose.x[Joint::LeftElbow.dof_offset()] = 0.5;
         let columns: Vec<String> = header().trim_end().split(',').map(String::from).collect();
         assert_eq!(columns.len(), 7 + 3 * Joint::ALL.len() + DOF);
-        let line = row(3, 0.2, Some("wave, fast"), &body, &pose);
+        let line = row(3, 0.2, Some("wave, fast"), &pose, &body.forward(&pose));
         let cells: Vec<&str> = line.trim_end().splitn(4, ',').collect();
         assert_eq!(&cells[..3], ["3", "0.2", "\"wave"]);
         let values: Vec<f64> =
