@@ -2,9 +2,11 @@
 //!
 //! - `draw/<size>`: the body's capsules drawn into a mask;
 //! - `distance_field/<size>`: the exact squared EDT of a silhouette;
-//! - `likelihood/<size>`: one evaluation as the tracker makes it, drawing
-//!   the hypothesis and scoring it against an observation (eq. 8–9) whose
-//!   distance field was computed once.
+//! - `score/<size>`: eq. 8–9 for a hypothesis already drawn;
+//! - `likelihood/<size>`: one evaluation as the tracker makes it
+//!   (`Scorer::score`): forward kinematics, drawing the hypothesis and
+//!   scoring it against an observation (eq. 8–9) whose distance field was
+//!   computed once.
 //!
 //! The poses are frames of the shipped horizontal-waving take: the
 //! observation one frame, the hypothesis the next. Criterion reports the
@@ -16,9 +18,10 @@ use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use imitate::mocap::body::Body;
 use imitate::mocap::pose::Pose;
 use imitate::vision::camera::{Camera, Preset};
-use imitate::vision::distance::{DistanceField, Observation};
+use imitate::vision::distance::{DistanceField, Observation, Scratch};
 use imitate::vision::mask::Mask;
 use imitate::vision::render::draw;
+use imitate::vision::scorer::Scorer;
 use imitate::vision::shape::capsules;
 use imitate::vocab::corpus;
 use std::hint::black_box;
@@ -57,13 +60,14 @@ fn vision(c: &mut Criterion) {
         c.bench_function(&format!("distance_field/{size}"), |b| {
             b.iter(|| field.compute_into(black_box(observation.mask())))
         });
-        let mut scratch = DistanceField::new();
+        let mut scratch = Scratch::default();
+        let drawn = silhouette(&camera, &body, &hypothesis);
+        c.bench_function(&format!("score/{size}"), |b| {
+            b.iter(|| observation.likelihood(black_box(&drawn), &mut scratch))
+        });
+        let mut scorer = Scorer::new(camera.clone(), body.clone());
         c.bench_function(&format!("likelihood/{size}"), |b| {
-            b.iter(|| {
-                mask.clear();
-                draw(&camera, &capsules(&body, &body.forward(black_box(&hypothesis))), &mut mask);
-                observation.likelihood(&mask, &mut scratch)
-            })
+            b.iter(|| scorer.score(&observation, black_box(&hypothesis)))
         });
     }
 }

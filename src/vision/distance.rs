@@ -101,7 +101,7 @@ impl DistanceField {
         }
         self.vertical.resize(width * height, 0);
         self.envelope.resize(width, Parabola::default());
-        vertical_pass(&mut self.vertical, mask.pixels(), width);
+        vertical_pass(&mut self.vertical, mask.pixels().chunks_exact(width), width);
         // After the vertical pass, a column holds a set pixel iff its top
         // value is finite.
         self.occupied.clear();
@@ -135,13 +135,15 @@ impl DistanceField {
     }
 }
 
-/// Leaves in `g` every pixel's distance (not squared) to the nearest set
-/// pixel in its column, or `NO_PIXEL`. Both sweeps run a row at a time and
-/// branch-free, so the inner loops are contiguous and vectorise.
-fn vertical_pass(g: &mut [u16], pixels: &[u8], width: usize) {
+/// Leaves in `g` (`width` per row) every pixel's distance (not squared) to
+/// the nearest set pixel in its column, or `NO_PIXEL`, for the mask rows
+/// `pixels` (each `width` long: a whole mask, or a band of one). Both sweeps
+/// run a row at a time and branch-free, so the inner loops are contiguous
+/// and vectorise.
+fn vertical_pass<'a>(g: &mut [u16], pixels: impl Iterator<Item = &'a [u8]>, width: usize) {
     // 0 for a set pixel, all ones (so `&` keeps the other operand) for a clear one.
     let clear = |p: u8| u16::from(p).wrapping_sub(1);
-    let mut rows = g.chunks_exact_mut(width).zip(pixels.chunks_exact(width));
+    let mut rows = g.chunks_exact_mut(width).zip(pixels);
     let Some((first, first_pixels)) = rows.next() else { return };
     for (g, &p) in first.iter_mut().zip(first_pixels) {
         *g = clear(p);
@@ -181,22 +183,7 @@ fn horizontal_pass(g: &[u16], occupied: &[u32], d: &mut [u32], envelope: &mut [P
             left_out = true;
             continue;
         }
-        let (apex, g) = (q as i64, i64::from(g[q]));
-        let next = Parabola { apex, lift: g * g + apex * apex };
-        // `last` covers no x once `next` undercuts it no later than `last`
-        // undercut `before`. The crossing of parabolas a < b is at
-        // x = (b.lift − a.lift) / 2(b.apex − a.apex); cross-multiplying the
-        // two crossings keeps the test exact and free of division.
-        while let [.., before, last] = envelope[..len] {
-            let next_crosses = (next.lift - last.lift) * (last.apex - before.apex);
-            let last_crossed = (last.lift - before.lift) * (next.apex - last.apex);
-            if next_crosses > last_crossed {
-                break;
-            }
-            len -= 1;
-        }
-        envelope[len] = next;
-        len += 1;
+        len = push(envelope, len, Parabola::new(q as i64, i64::from(g[q])));
     }
     // Each parabola is lowest from where it took over up to where the next
     // one does: a division per parabola, then a tight loop per pixel.
@@ -218,6 +205,31 @@ fn horizontal_pass(g: &[u16], occupied: &[u32], d: &mut [u32], envelope: &mut [P
             *d &= 0u32.wrapping_sub(u32::from(g != 0));
         }
     }
+}
+
+impl Parabola {
+    fn new(apex: i64, g: i64) -> Parabola {
+        Parabola { apex, lift: g * g + apex * apex }
+    }
+}
+
+/// Adds `next` (right of every parabola so far) to the lower envelope held
+/// in `envelope[..len]`, dropping those it hides; returns the new length.
+fn push(envelope: &mut [Parabola], mut len: usize, next: Parabola) -> usize {
+    // `last` covers no x once `next` undercuts it no later than `last`
+    // undercut `before`. The crossing of parabolas a < b is at
+    // x = (b.lift − a.lift) / 2(b.apex − a.apex); cross-multiplying the
+    // two crossings keeps the test exact and free of division.
+    while let [.., before, last] = envelope[..len] {
+        let next_crosses = (next.lift - last.lift) * (last.apex - before.apex);
+        let last_crossed = (last.lift - before.lift) * (next.apex - last.apex);
+        if next_crosses > last_crossed {
+            break;
+        }
+        len -= 1;
+    }
+    envelope[len] = next;
+    len + 1
 }
 
 /// The first x at which `next` is at least as low as `p` (`p.apex <
@@ -269,11 +281,81 @@ pub fn directed_cost(a: &Mask, b: &DistanceField) -> u64 {
 
 /// One frame's observed silhouette B with its distance field, built once and
 /// then asked for the likelihood of many hypotheses.
+///
+/// r(A, B) reads B's field at A's pixels. r(B, A) needs A's distances only
+/// at B's pixels, so instead of A's whole field it runs the transform's
+/// vertical pass over A's bounding box alone, builds each row's lower
+/// envelope only for rows holding B's pixels, and sums each envelope
+/// parabola over the stretch of B's runs it covers in closed form: no
+/// per-pixel work in the horizontal pass, and the same exact integers.
 #[derive(Clone, Debug)]
 pub struct Observation {
     mask: Mask,
     field: DistanceField,
     epsilon: f64,
+    /// B's set pixels as runs: row y's are `runs[row_starts[y]..row_starts[y + 1]]`.
+    runs: Vec<Run>,
+    row_starts: Vec<usize>,
+    count: u64,
+}
+
+/// Columns `start..end` of one row, all set.
+#[derive(Clone, Copy, Debug)]
+struct Run {
+    start: i64,
+    end: i64,
+}
+
+/// The buffers scoring a hypothesis works in, reused so that scoring
+/// allocates nothing once it has seen a frame of the same size.
+#[derive(Clone, Debug, Default)]
+pub struct Scratch {
+    /// The vertical pass over the hypothesis's bounding box.
+    vertical: Vec<u16>,
+    /// The box's columns holding a hypothesis pixel (relative to the box).
+    occupied: Vec<u32>,
+    envelope: Vec<Parabola>,
+    /// Which columns of the image hold a hypothesis pixel.
+    columns: Vec<u8>,
+    /// One row's inner columns of A's runs, and B's runs less those.
+    inside: Vec<Run>,
+    outside: Vec<Run>,
+}
+
+/// The smallest box holding every set pixel of a mask: rows `top..=bottom`,
+/// columns `left..=right`.
+#[derive(Clone, Copy, Debug)]
+struct Bounds {
+    top: usize,
+    bottom: usize,
+    left: usize,
+    right: usize,
+}
+
+impl Bounds {
+    /// `None` for a mask with no pixel set. `columns` is scratch.
+    fn of(mask: &Mask, columns: &mut Vec<u8>) -> Option<Bounds> {
+        let width = mask.width();
+        // An OR fold has no early exit, so it vectorises.
+        let any = |row: &[u8]| row.iter().fold(0, |acc, &p| acc | p) != 0;
+        let rows = || mask.pixels().chunks_exact(width.max(1));
+        let top = rows().position(any)?;
+        let bottom = mask.height() - 1 - rows().rev().position(any)?;
+        columns.clear();
+        columns.resize(width, 0);
+        for row in rows().skip(top).take(bottom - top + 1) {
+            for (c, &p) in columns.iter_mut().zip(row) {
+                *c |= p;
+            }
+        }
+        let left = columns.iter().position(|&c| c != 0)?;
+        let right = columns.iter().rposition(|&c| c != 0)?;
+        Some(Bounds { top, bottom, left, right })
+    }
+
+    fn width(&self) -> usize {
+        self.right - self.left + 1
+    }
 }
 
 impl Observation {
@@ -289,7 +371,18 @@ impl Observation {
     pub fn with_epsilon(mask: Mask, epsilon: f64) -> Observation {
         assert!(epsilon.is_finite() && epsilon > 0.0, "ε must be finite and positive, not {epsilon}");
         let field = DistanceField::of(&mask);
-        Observation { mask, field, epsilon }
+        let (mut runs, mut row_starts) = (Vec::new(), vec![0]);
+        for row in mask.pixels().chunks_exact(mask.width().max(1)).take(mask.height()) {
+            let mut x = 0;
+            while let Some(start) = row[x..].iter().position(|&p| p != 0).map(|s| x + s) {
+                let end = row[start..].iter().position(|&p| p == 0).map_or(row.len(), |e| start + e);
+                runs.push(Run { start: start as i64, end: end as i64 });
+                x = end;
+            }
+            row_starts.push(runs.len());
+        }
+        let count = mask.count() as u64;
+        Observation { mask, field, epsilon, runs, row_starts, count }
     }
 
     pub fn mask(&self) -> &Mask {
@@ -304,28 +397,160 @@ impl Observation {
         self.epsilon
     }
 
-    /// (r(A, B), r(B, A)) for hypothesis A. Leaves A's distance field in
-    /// `scratch`, whose buffers are reused.
+    /// (r(A, B), r(B, A)) for hypothesis A.
     ///
     /// # Panics
     /// If `hypothesis` differs in size from the observed mask.
-    pub fn costs(&self, hypothesis: &Mask, scratch: &mut DistanceField) -> (u64, u64) {
-        let forward = directed_cost(hypothesis, &self.field);
-        scratch.compute_into(hypothesis);
-        (forward, directed_cost(&self.mask, scratch))
+    pub fn costs(&self, hypothesis: &Mask, scratch: &mut Scratch) -> (u64, u64) {
+        let (width, height) = (self.mask.width(), self.mask.height());
+        assert_eq!((hypothesis.width(), hypothesis.height()), (width, height), "mask and observation differ in size");
+        let Some(bounds) = Bounds::of(hypothesis, &mut scratch.columns) else {
+            // r(∅, B) = 0; r(B, ∅) as `DistanceField` defines "no pixel".
+            return (0, self.count * u64::from(absent_distance(width, height)));
+        };
+        // r(A, B) over A's box only, as `directed_cost` sums: in u32 lanes
+        // per row, which a row's (w² + h²)·w cannot overflow below ~1600 pixels
+        // a side; wider frames sum in u64.
+        let columns = bounds.left..=bounds.right;
+        let forward = (bounds.top..=bounds.bottom)
+            .map(|y| {
+                let a = &hypothesis.pixels()[y * width..][columns.clone()];
+                let d = &self.field.values[y * width..][columns.clone()];
+                let terms = a.iter().zip(d).map(|(&p, &d)| d & 0u32.wrapping_sub(u32::from(p)));
+                if width <= 1600 { u64::from(terms.sum::<u32>()) } else { terms.map(u64::from).sum() }
+            })
+            .sum();
+        (forward, self.cost_to(hypothesis, bounds, scratch))
+    }
+
+    /// r(B, A): Σ over B's pixels of the squared distance to A's nearest,
+    /// for A with pixels inside `bounds`.
+    fn cost_to(&self, hypothesis: &Mask, bounds: Bounds, scratch: &mut Scratch) -> u64 {
+        let (width, box_width) = (self.mask.width(), bounds.width());
+        let box_height = bounds.bottom - bounds.top + 1;
+        let Scratch { vertical, occupied, envelope, inside, outside, .. } = scratch;
+        vertical.resize(box_width * box_height, 0);
+        let rows = (bounds.top..=bounds.bottom).map(|y| &hypothesis.pixels()[y * width..][bounds.left..=bounds.right]);
+        vertical_pass(vertical, rows, box_width);
+        occupied.clear();
+        occupied.extend((0..box_width as u32).filter(|&q| vertical[q as usize] != NO_PIXEL));
+        envelope.resize(box_width, Parabola::default());
+        let (first, last) = (&vertical[..box_width], &vertical[(box_height - 1) * box_width..]);
+        let mut total = 0;
+        for y in 0..self.mask.height() {
+            let runs = &self.runs[self.row_starts[y]..self.row_starts[y + 1]];
+            if runs.is_empty() {
+                continue;
+            }
+            // Outside the box, a column's nearest A pixel is its top- (or
+            // bottom-) most, the box edge's distance plus the rows between.
+            let (g, beyond) = if y < bounds.top {
+                (first, bounds.top - y)
+            } else if y > bounds.bottom {
+                (last, y - bounds.bottom)
+            } else {
+                (&vertical[(y - bounds.top) * box_width..][..box_width], 0)
+            };
+            let mut len = 0;
+            // As in `horizontal_pass`, the inner columns of a run of A's
+            // pixels stay out of the envelope (outside the run its ends are
+            // nearer); B's pixels there are at distance 0, so they are cut
+            // out of B's runs instead.
+            inside.clear();
+            for &q in occupied.iter() {
+                let q = q as usize;
+                let apex = (bounds.left + q) as i64;
+                if beyond == 0 && g[q] == 0 && q > 0 && q + 1 < box_width && g[q - 1] == 0 && g[q + 1] == 0 {
+                    match inside.last_mut() {
+                        Some(run) if run.end == apex => run.end += 1,
+                        _ => inside.push(Run { start: apex, end: apex + 1 }),
+                    }
+                    continue;
+                }
+                len = push(envelope, len, Parabola::new(apex, i64::from(g[q]) + beyond as i64));
+            }
+            if inside.is_empty() {
+                total += sum_over_runs(&envelope[..len], runs);
+            } else {
+                subtract(runs, inside, outside);
+                total += sum_over_runs(&envelope[..len], outside);
+            }
+        }
+        total
     }
 
     /// R(A, B) of eq. 8 for hypothesis A, in (0, 1/ε]: 1/ε exactly when A = B
-    /// (including both empty), finite always. `scratch` is overwritten with
-    /// A's distance field.
+    /// (including both empty), finite always.
     ///
     /// # Panics
     /// If `hypothesis` differs in size from the observed mask.
-    pub fn likelihood(&self, hypothesis: &Mask, scratch: &mut DistanceField) -> f64 {
+    pub fn likelihood(&self, hypothesis: &Mask, scratch: &mut Scratch) -> f64 {
         let (forward, backward) = self.costs(hypothesis, scratch);
         // Summed as integers first, so R(A, B) and R(B, A) are the same f64;
         // exact in f64 for any image below ~10⁵ pixels a side.
         1.0 / ((forward + backward) as f64 + self.epsilon)
+    }
+}
+
+/// Σ over the columns of `runs` of the lower `envelope` there: each
+/// parabola summed in closed form over the part of each run it covers.
+fn sum_over_runs(envelope: &[Parabola], runs: &[Run]) -> u64 {
+    let end_of = |k: usize| envelope.get(k + 1).map_or(i64::MAX, |next| takes_over(&envelope[k], next));
+    let (mut k, mut end) = (0, end_of(0));
+    let mut total = 0;
+    for run in runs {
+        let mut x = run.start;
+        while x < run.end {
+            while end <= x {
+                k += 1;
+                end = end_of(k);
+            }
+            let stop = end.min(run.end);
+            let p = &envelope[k];
+            let g2 = p.lift - p.apex * p.apex;
+            total += (stop - x) * g2 + squares_between(x - p.apex, stop - 1 - p.apex);
+            x = stop;
+        }
+    }
+    total as u64
+}
+
+/// Leaves in `out` the columns of `runs` not in `cut` (both sorted and
+/// disjoint), as runs.
+fn subtract(runs: &[Run], cut: &[Run], out: &mut Vec<Run>) {
+    out.clear();
+    let mut cut = cut.iter().peekable();
+    for run in runs {
+        let mut start = run.start;
+        while start < run.end {
+            // Cuts wholly left of what remains of this run cut nothing more.
+            while cut.next_if(|c| c.end <= start).is_some() {}
+            match cut.peek() {
+                Some(c) if c.start < run.end => {
+                    if c.start > start {
+                        out.push(Run { start, end: c.start });
+                    }
+                    start = c.end;
+                }
+                _ => {
+                    out.push(Run { start, end: run.end });
+                    break;
+                }
+            }
+        }
+    }
+}
+
+/// Σ t² for t from `lo` to `hi` (lo ≤ hi), either sign.
+fn squares_between(lo: i64, hi: i64) -> i64 {
+    // Σ_{t=1}^{n} t², which is 0 at n = 0 and at n = −1.
+    let upto = |n: i64| n * (n + 1) * (2 * n + 1) / 6;
+    if lo >= 0 {
+        upto(hi) - upto(lo - 1)
+    } else if hi <= 0 {
+        upto(-lo) - upto(-hi - 1)
+    } else {
+        upto(-lo) + upto(hi)
     }
 }
 
@@ -486,33 +711,73 @@ mod tests {
             let field = DistanceField::of(&mask);
             assert!(field.values().is_empty());
             assert_eq!(directed_cost(&mask, &field), 0);
-            assert_eq!(Observation::new(mask.clone()).likelihood(&mask, &mut DistanceField::new()), 1.0 / EPSILON);
+            assert_eq!(Observation::new(mask.clone()).likelihood(&mask, &mut Scratch::default()), 1.0 / EPSILON);
         }
     }
 
     #[test]
     fn directed_cost_matches_brute_force_on_random_pairs() {
-        let pairs = masks().prop_flat_map(|a| {
-            let (w, h) = (a.width(), a.height());
-            (Just(a), proptest::collection::vec(0u32..100, w * h), prop_oneof![Just(0u32), 0u32..=5, 0u32..=100])
-                .prop_map(move |(a, draws, density)| {
-                    let b = Mask::from_fn(w, h, |x, y| draws[y * w + x] < density);
-                    (a, b)
-                })
-        });
-        check(pairs, |(a, b)| {
+        check(mask_pairs(), |(a, b)| {
             prop_assert_eq!(directed_cost(&a, &DistanceField::of(&b)), cost_by_brute_force(&a, &b));
             prop_assert_eq!(directed_cost(&b, &DistanceField::of(&a)), cost_by_brute_force(&b, &a));
             Ok(())
         });
     }
 
+    /// Pairs of masks of one size, B drawn independently of A.
+    fn mask_pairs() -> impl Strategy<Value = (Mask, Mask)> {
+        masks().prop_flat_map(|a| {
+            let (w, h) = (a.width(), a.height());
+            (Just(a), proptest::collection::vec(0u32..100, w * h), prop_oneof![Just(0u32), 0u32..=5, 0u32..=100])
+                .prop_map(move |(a, draws, density)| {
+                    let b = Mask::from_fn(w, h, |x, y| draws[y * w + x] < density);
+                    (a, b)
+                })
+        })
+    }
+
+    #[test]
+    fn observation_costs_match_brute_force_on_random_pairs() {
+        check(mask_pairs(), |(a, b)| {
+            let costs = Observation::new(b.clone()).costs(&a, &mut Scratch::default());
+            prop_assert_eq!(costs, (cost_by_brute_force(&a, &b), cost_by_brute_force(&b, &a)));
+            Ok(())
+        });
+    }
+
+    /// The hypothesis side works inside A's bounding box: B's pixels above,
+    /// below and beside it, and boxes touching every edge, at frame sizes.
+    #[test]
+    fn observation_costs_match_brute_force_for_blobs_anywhere_in_a_frame() {
+        let mut rng = ChaCha8Rng::seed_from_u64(6);
+        let mut scratch = Scratch::default();
+        let blob = |rng: &mut ChaCha8Rng, w: usize, h: usize| {
+            let (cx, cy) = (rng.gen_range(-5.0..w as f64 + 5.0), rng.gen_range(-5.0..h as f64 + 5.0));
+            let (rx, ry) = (rng.gen_range(0.5..w as f64 / 3.0), rng.gen_range(0.5..h as f64 / 3.0));
+            Mask::from_fn(w, h, move |x, y| ((x as f64 - cx) / rx).powi(2) + ((y as f64 - cy) / ry).powi(2) <= 1.0)
+        };
+        for _ in 0..60 {
+            let (w, h) = (rng.gen_range(1..=96), rng.gen_range(1..=72));
+            let (a, b) = (blob(&mut rng, w, h), blob(&mut rng, w, h));
+            let costs = Observation::new(b.clone()).costs(&a, &mut scratch);
+            assert_eq!(costs, (cost_by_brute_force(&a, &b), cost_by_brute_force(&b, &a)), "{w} × {h}");
+        }
+    }
+
+    #[test]
+    fn squares_between_sums_squares_of_either_sign() {
+        for lo in -6..=6 {
+            for hi in lo..=6 {
+                assert_eq!(squares_between(lo, hi), (lo..=hi).map(|t| t * t).sum::<i64>(), "{lo}..={hi}");
+            }
+        }
+    }
+
     #[test]
     fn likelihood_of_small_cases_matches_hand_computation() {
         let pixel = |w, h, px, py| Mask::from_fn(w, h, move |x, y| (x, y) == (px, py));
-        let mut scratch = DistanceField::new();
-        let likelihood =
-            |a: &Mask, b: &Mask, scratch: &mut DistanceField| Observation::new(b.clone()).likelihood(a, scratch);
+        let mut scratch = Scratch::default();
+        let likelihood = |a: &Mask, b: &Mask, scratch: &mut Scratch| Observation::new(b.clone()).likelihood(a, scratch);
         // Same lone pixel: both sums are empty of cost.
         assert_eq!(likelihood(&pixel(5, 5, 2, 2), &pixel(5, 5, 2, 2), &mut scratch), 1.0);
         // Pixels 3-4-5 apart: 25 each way.
@@ -535,15 +800,8 @@ mod tests {
 
     #[test]
     fn likelihood_is_symmetric_and_finite() {
-        let pairs = masks().prop_flat_map(|a| {
-            let (w, h) = (a.width(), a.height());
-            (Just(a), proptest::collection::vec(0u32..100, w * h), 0u32..=100).prop_map(move |(a, draws, density)| {
-                let b = Mask::from_fn(w, h, |x, y| draws[y * w + x] < density);
-                (a, b)
-            })
-        });
-        check(pairs, |(a, b)| {
-            let mut scratch = DistanceField::new();
+        check(mask_pairs(), |(a, b)| {
+            let mut scratch = Scratch::default();
             let ab = Observation::new(b.clone()).likelihood(&a, &mut scratch);
             let ba = Observation::new(a.clone()).likelihood(&b, &mut scratch);
             prop_assert_eq!(ab, ba);
@@ -555,7 +813,7 @@ mod tests {
     #[test]
     fn likelihood_is_highest_when_hypothesis_equals_observation() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let mut scratch = DistanceField::new();
+        let mut scratch = Scratch::default();
         for _ in 0..200 {
             let (w, h) = (rng.gen_range(1..=40), rng.gen_range(1..=30));
             let density = [0.0, 0.02, 0.3, 0.9, 1.0][rng.gen_range(0..5)];
@@ -595,7 +853,7 @@ mod tests {
     #[test]
     #[should_panic(expected = "differ in size")]
     fn likelihood_rejects_a_hypothesis_of_another_size() {
-        Observation::new(Mask::new(4, 3)).likelihood(&Mask::new(3, 4), &mut DistanceField::new());
+        Observation::new(Mask::new(4, 3)).likelihood(&Mask::new(3, 4), &mut Scratch::default());
     }
 
     #[test]

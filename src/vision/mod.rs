@@ -5,5 +5,6 @@ pub mod camera;
 pub mod distance;
 pub mod mask;
 pub mod render;
+pub mod scorer;
 pub mod shape;
 pub mod truth;

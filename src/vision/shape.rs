@@ -24,9 +24,11 @@ enum Span {
 /// Every capsule and its radius as a share of standing height. Radii are
 /// half the typical breadth of each part for an adult (anthropometric
 /// tables give head breadth ≈ 0.087 H, thigh ≈ 0.09 H, upper arm
-/// ≈ 0.055 H, …); the trunk is two capsules, hip to shoulder on each side,
-/// so it is broad seen from the front and shallow from the side.
-const PARTS: [(Span, f64); 16] = {
+/// ≈ 0.055 H, …). The trunk is three capsules: hip to shoulder on each
+/// side, so it is broad seen from the front and shallow from the side, and
+/// (last) pelvis to neck, which fills the chest between them and gives the
+/// trunk its depth (chest depth ≈ 0.12 H).
+const PARTS: [(Span, f64); 17] = {
     use Joint::*;
     [
         (Span::Bone(Head), 0.050),
@@ -45,6 +47,7 @@ const PARTS: [(Span, f64); 16] = {
         (Span::Joints(RightKnee, RightAnkle), 0.029),
         (Span::Bone(LeftAnkle), 0.020),
         (Span::Bone(RightAnkle), 0.020),
+        (Span::Joints(Pelvis, Neck), 0.060),
     ]
 };
 
@@ -92,7 +95,9 @@ mod tests {
             assert!(bottom > -0.03 * height && bottom < 0.0, "{height}: the feet reach {bottom}");
             assert!((span - tips).abs() < 0.04 * height, "{height}: span {span}, finger tips {tips}");
         }
-        let trunk = PARTS.iter().find(|p| matches!(p.0, Span::Joints(Joint::LeftHip, _))).unwrap().1;
-        assert!(PARTS.iter().all(|p| p.1 <= trunk));
+        let radius = |from: Joint| PARTS.iter().find(|p| matches!(p.0, Span::Joints(f, _) if f == from)).unwrap().1;
+        let (side, middle) = (radius(Joint::LeftHip), radius(Joint::Pelvis));
+        assert!(middle >= side);
+        assert!(PARTS.iter().filter(|p| p.1 != middle).all(|p| p.1 <= side));
     }
 }
