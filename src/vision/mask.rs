@@ -22,6 +22,17 @@ impl Mask {
         Mask { width, height, pixels: pixels.collect() }
     }
 
+    /// A mask over `pixels`, row-major from the top-left, each 0 or 1.
+    ///
+    /// # Panics
+    /// If `pixels` does not hold `width × height` bytes, or holds a value
+    /// other than 0 or 1: either is a bug in the caller.
+    pub fn from_pixels(width: usize, height: usize, pixels: Vec<u8>) -> Mask {
+        assert_eq!(pixels.len(), width * height, "a {width}×{height} mask needs {} pixels", width * height);
+        assert!(pixels.iter().all(|&p| p <= 1), "mask pixels are 0 or 1");
+        Mask { width, height, pixels }
+    }
+
     pub fn width(&self) -> usize {
         self.width
     }
@@ -41,6 +52,12 @@ impl Mask {
     /// Every pixel, row-major, 0 or 1.
     pub fn pixels(&self) -> &[u8] {
         &self.pixels
+    }
+
+    /// Every pixel, row-major, for writing in place. Writers keep each
+    /// value 0 or 1, as every reader of a mask assumes.
+    pub fn pixels_mut(&mut self) -> &mut [u8] {
+        &mut self.pixels
     }
 
     /// Sets every pixel of row `y` from `x0` to `x1` (exclusive) inside.

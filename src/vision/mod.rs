@@ -3,8 +3,10 @@
 
 pub mod camera;
 pub mod distance;
+pub mod frames;
 pub mod mask;
 pub mod render;
 pub mod scorer;
 pub mod shape;
+pub mod silhouette;
 pub mod truth;

@@ -1,0 +1,885 @@
+//! Silhouettes from frames: a silhouette frame is thresholded; a color frame
+//! is compared with a background image, with shadows suppressed, then
+//! cleaned by a median filter, the removal of small blobs and the filling of
+//! small holes.
+//!
+//! Written for speed (a 640×480 frame in well under 2 ms on one core):
+//! integer arithmetic, row-contiguous loops, a median filter that counts the
+//! set pixels of its window by separable box sums, and connected components
+//! found over runs of pixels rather than pixel by pixel. An [`Extractor`]
+//! keeps its scratch buffers, so after the first frame it allocates nothing.
+
+use crate::vision::frames::{Frame, FrameError, FrameKind, FrameSource};
+use crate::vision::mask::Mask;
+use thiserror::Error;
+
+/// How many frames, at most, the per-pixel median background is taken over.
+pub const MEDIAN_SAMPLE: usize = 64;
+
+/// The largest median filter radius (a 15×15 window, whose count still fits
+/// a byte).
+pub const MAX_MEDIAN_RADIUS: usize = 7;
+
+/// Why a silhouette cannot be extracted.
+#[derive(Debug, Error)]
+pub enum SilhouetteError {
+    #[error("{frame}: the frame is {width}×{height}; the background is {background_width}×{background_height}")]
+    SizeMismatch { frame: String, width: usize, height: usize, background_width: usize, background_height: usize },
+    #[error("{frame}: a color frame, and no background to subtract was given")]
+    NoBackground { frame: String },
+    #[error("no frames to take a median background from")]
+    NoFrames,
+    #[error(transparent)]
+    Frames(#[from] FrameError),
+}
+
+/// A setting of [`ExtractParams`] out of its range.
+#[derive(Debug, Error, PartialEq)]
+pub enum ExtractParamsError {
+    #[error("the difference threshold must be 1 to 764 (a sum over three channels of 0 to 255), not {0}")]
+    Threshold(u16),
+    #[error("the shadow brightness ratios must satisfy 0 < low ≤ high < 1, not {low} and {high}")]
+    ShadowRatio { low: f32, high: f32 },
+    #[error("the shadow color tolerance must be at most 765, not {0}")]
+    ShadowChroma(u16),
+    #[error("the median filter radius must be at most {MAX_MEDIAN_RADIUS}, not {0}")]
+    MedianRadius(usize),
+    #[error("the smallest blob must be a fraction of the image in [0, 1), not {0}")]
+    MinBlob(f64),
+    #[error("the largest hole filled must be a fraction of the image in [0, 1), not {0}")]
+    MaxHole(f64),
+}
+
+/// Settings of background subtraction and cleaning; each setter takes and
+/// returns the settings, and [`Extractor::new`] checks them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExtractParams {
+    threshold: u16,
+    shadow_low: f32,
+    shadow_high: f32,
+    shadow_chroma: u16,
+    median_radius: usize,
+    min_blob: f64,
+    max_hole: f64,
+}
+
+impl Default for ExtractParams {
+    fn default() -> ExtractParams {
+        ExtractParams {
+            threshold: 60,
+            shadow_low: 0.35,
+            shadow_high: 0.95,
+            shadow_chroma: 40,
+            median_radius: 1,
+            min_blob: 0.002,
+            max_hole: 0.0005,
+        }
+    }
+}
+
+impl ExtractParams {
+    /// A pixel differs from the background when the sum over R, G and B of
+    /// the absolute differences exceeds this (default 60: about 20 a
+    /// channel, several times camera noise).
+    pub fn threshold(mut self, sum_abs_diff: u16) -> ExtractParams {
+        self.threshold = sum_abs_diff;
+        self
+    }
+
+    /// A pixel whose brightness (R + G + B) is between `low` and `high`
+    /// times the background's, and whose color is nearly the background's
+    /// scaled by that ratio, is shadow, counted as background (default 0.35
+    /// to 0.95).
+    pub fn shadow_ratio(mut self, low: f32, high: f32) -> ExtractParams {
+        (self.shadow_low, self.shadow_high) = (low, high);
+        self
+    }
+
+    /// How near "nearly the background's color" is for a shadow: the sum
+    /// over channels of `|c − ratio·C|` (frame `c`, background `C`) at most
+    /// this (default 40; 0 turns shadow suppression off).
+    pub fn shadow_chroma(mut self, sum_abs_diff: u16) -> ExtractParams {
+        self.shadow_chroma = sum_abs_diff;
+        self
+    }
+
+    /// The median filter's window is `2·radius + 1` pixels square (default
+    /// 1: 3×3; 0 turns it off).
+    pub fn median_radius(mut self, radius: usize) -> ExtractParams {
+        self.median_radius = radius;
+        self
+    }
+
+    /// Connected blobs (8-connected) smaller than this fraction of the
+    /// image's area are removed (default 0.002: 38 pixels at 160×120, 614 at
+    /// 640×480; 0 keeps every blob).
+    pub fn min_blob(mut self, fraction: f64) -> ExtractParams {
+        self.min_blob = fraction;
+        self
+    }
+
+    /// Holes (4-connected background regions not touching the image's edge)
+    /// at most this fraction of the image's area are filled (default 0.0005:
+    /// 9 pixels at 160×120, 153 at 640×480; 0 fills none).
+    pub fn max_hole(mut self, fraction: f64) -> ExtractParams {
+        self.max_hole = fraction;
+        self
+    }
+
+    fn check(&self) -> Result<(), ExtractParamsError> {
+        if !(1..=764).contains(&self.threshold) {
+            return Err(ExtractParamsError::Threshold(self.threshold));
+        }
+        let (low, high) = (self.shadow_low, self.shadow_high);
+        if !(low > 0.0 && low <= high && high < 1.0) {
+            return Err(ExtractParamsError::ShadowRatio { low, high });
+        }
+        if self.shadow_chroma > 765 {
+            return Err(ExtractParamsError::ShadowChroma(self.shadow_chroma));
+        }
+        if self.median_radius > MAX_MEDIAN_RADIUS {
+            return Err(ExtractParamsError::MedianRadius(self.median_radius));
+        }
+        if !(0.0..1.0).contains(&self.min_blob) {
+            return Err(ExtractParamsError::MinBlob(self.min_blob));
+        }
+        if !(0.0..1.0).contains(&self.max_hole) {
+            return Err(ExtractParamsError::MaxHole(self.max_hole));
+        }
+        Ok(())
+    }
+}
+
+/// Turns frames into masks. Holds the background and every scratch buffer,
+/// so extracting frame after frame of one size allocates nothing after the
+/// first.
+#[derive(Debug)]
+pub struct Extractor {
+    params: ExtractParams,
+    difference: Difference,
+    background: Option<Background>,
+    /// The channels' differences of one row.
+    diff: Vec<u8>,
+    /// The marked pixels before the median filter.
+    raw: Vec<u8>,
+    median: MedianScratch,
+    components: Components,
+}
+
+#[derive(Debug)]
+struct Background {
+    width: usize,
+    height: usize,
+    rgb: Vec<u8>,
+}
+
+impl Extractor {
+    /// An extractor with no background yet: it thresholds silhouette frames
+    /// and needs [`Extractor::set_background`] before color frames.
+    pub fn new(params: ExtractParams) -> Result<Extractor, ExtractParamsError> {
+        params.check()?;
+        Ok(Extractor {
+            params,
+            difference: Difference {
+                threshold: u32::from(params.threshold),
+                chroma: i32::from(params.shadow_chroma),
+                low_256: (params.shadow_low * 256.0).round() as i32,
+                high_256: (params.shadow_high * 256.0).round() as i32,
+            },
+            background: None,
+            diff: Vec::new(),
+            raw: Vec::new(),
+            median: MedianScratch::default(),
+            components: Components::default(),
+        })
+    }
+
+    pub fn params(&self) -> &ExtractParams {
+        &self.params
+    }
+
+    /// The image color frames are compared with (such as `background.png`,
+    /// or [`median_background`] of the frames).
+    pub fn set_background(&mut self, background: &Frame) {
+        self.background =
+            Some(Background { width: background.width(), height: background.height(), rgb: background.rgb().to_vec() });
+    }
+
+    /// The person's mask in `frame`, written into `out` (resized to the
+    /// frame if it differs). A silhouette frame is thresholded (a pixel
+    /// whose mean channel is 128 or more is the person); a color frame goes
+    /// through background subtraction, the median filter, blob removal and
+    /// hole filling.
+    pub fn extract_into(&mut self, frame: &Frame, out: &mut Mask) -> Result<(), SilhouetteError> {
+        let (width, height) = (frame.width(), frame.height());
+        if frame.kind() == FrameKind::Color {
+            let Some(background) = &self.background else {
+                return Err(SilhouetteError::NoBackground { frame: frame.label().into() });
+            };
+            if (background.width, background.height) != (width, height) {
+                return Err(SilhouetteError::SizeMismatch {
+                    frame: frame.label().into(),
+                    width,
+                    height,
+                    background_width: background.width,
+                    background_height: background.height,
+                });
+            }
+        }
+        if (out.width(), out.height()) != (width, height) {
+            *out = Mask::new(width, height);
+        }
+        match frame.kind() {
+            FrameKind::Silhouette => threshold_into(frame.rgb(), out.pixels_mut()),
+            FrameKind::Color => self.subtract_and_clean(frame, out),
+        }
+        Ok(())
+    }
+
+    /// [`Extractor::extract_into`] a new mask.
+    pub fn extract(&mut self, frame: &Frame) -> Result<Mask, SilhouetteError> {
+        let mut mask = Mask::new(frame.width(), frame.height());
+        self.extract_into(frame, &mut mask)?;
+        Ok(mask)
+    }
+
+    fn subtract_and_clean(&mut self, frame: &Frame, out: &mut Mask) {
+        let (width, height) = (frame.width(), frame.height());
+        if width * height == 0 {
+            return;
+        }
+        let background = &self.background.as_ref().expect("checked by extract_into").rgb;
+        let radius = self.params.median_radius;
+        if radius == 0 {
+            self.difference.mark(frame.rgb(), background, width, &mut self.diff, out.pixels_mut());
+        } else {
+            self.raw.resize(width * height, 0);
+            self.difference.mark(frame.rgb(), background, width, &mut self.diff, &mut self.raw);
+            self.median.filter(&self.raw, width, height, radius, out.pixels_mut());
+        }
+        let area = (width * height) as f64;
+        let min_blob = (self.params.min_blob * area).ceil() as u32;
+        if min_blob > 1 {
+            self.components.remove_small(out.pixels_mut(), width, height, 1, min_blob);
+        }
+        let max_hole = (self.params.max_hole * area).floor() as u32;
+        if max_hole > 0 {
+            self.components.fill_holes(out.pixels_mut(), width, height, max_hole);
+        }
+    }
+}
+
+/// The background difference test, in integers.
+#[derive(Clone, Copy, Debug)]
+struct Difference {
+    threshold: u32,
+    chroma: i32,
+    /// The shadow brightness ratios in 1/256ths.
+    low_256: i32,
+    high_256: i32,
+}
+
+impl Difference {
+    /// Marks each pixel of a `width`-pixel-wide frame that differs from the
+    /// background and is not shadow. `diff` is scratch for one row.
+    fn mark(&self, rgb: &[u8], background: &[u8], width: usize, diff: &mut Vec<u8>, raw: &mut [u8]) {
+        let Difference { threshold, chroma, low_256: low, high_256: high } = *self;
+        // First every pixel's difference: the channels' absolute differences
+        // over the whole row at once (vector code, as the bytes are
+        // contiguous), then summed per pixel. Then the shadow test, only at
+        // the pixels marked (the person and its shadow, a small share).
+        diff.resize(3 * width, 0);
+        for ((c, b), out) in
+            rgb.chunks_exact(3 * width).zip(background.chunks_exact(3 * width)).zip(raw.chunks_exact_mut(width))
+        {
+            for ((d, &c), &b) in diff.iter_mut().zip(c).zip(b) {
+                *d = c.abs_diff(b);
+            }
+            for (d, o) in diff.chunks_exact(3).zip(out.iter_mut()) {
+                *o = u8::from(u32::from(d[0]) + u32::from(d[1]) + u32::from(d[2]) > threshold);
+            }
+        }
+        if chroma == 0 {
+            return;
+        }
+        // Over each run of marked pixels, every pixel tested without a branch.
+        let mut start = 0;
+        loop {
+            start = find(raw, start, 1);
+            if start == raw.len() {
+                break;
+            }
+            let end = find(raw, start, 0);
+            let (c, b) = (&rgb[3 * start..3 * end], &background[3 * start..3 * end]);
+            for ((c, b), out) in c.chunks_exact(3).zip(b.chunks_exact(3)).zip(&mut raw[start..end]) {
+                let (r, g, bl) = (c[0] as i32, c[1] as i32, c[2] as i32);
+                let (rb, gb, bb) = (b[0] as i32, b[1] as i32, b[2] as i32);
+                let (s, sb) = (r + g + bl, rb + gb + bb);
+                // Brightness ratio s/sb within [low, high], in 1/256ths.
+                let darker = s * 256 >= low * sb && s * 256 <= high * sb;
+                // Σ|c·sb − C·s| ≤ chroma·sb is Σ|c − (s/sb)·C| ≤ chroma:
+                // the color is the background's, scaled by the ratio.
+                let off = (r * sb - rb * s).abs() + (g * sb - gb * s).abs() + (bl * sb - bb * s).abs();
+                *out = u8::from(!(darker & (off <= chroma * sb)));
+            }
+            start = end;
+        }
+    }
+}
+
+/// A silhouette frame's mask: a pixel is the person when the mean of its
+/// channels is 128 or more.
+fn threshold_into(rgb: &[u8], out: &mut [u8]) {
+    for (p, o) in rgb.chunks_exact(3).zip(out.iter_mut()) {
+        *o = u8::from(u16::from(p[0]) + u16::from(p[1]) + u16::from(p[2]) >= 3 * 128);
+    }
+}
+
+/// The per-pixel median of `frames`, channel by channel (the upper of the
+/// two middle values for an even count): a background wherever the person
+/// covers each pixel in fewer than half of them. All frames must be one size.
+pub fn median_background(frames: &[Frame]) -> Result<Frame, SilhouetteError> {
+    let first = frames.first().ok_or(SilhouetteError::NoFrames)?;
+    let (width, height) = (first.width(), first.height());
+    if let Some(odd) = frames.iter().find(|f| (f.width(), f.height()) != (width, height)) {
+        return Err(SilhouetteError::SizeMismatch {
+            frame: odd.label().into(),
+            width: odd.width(),
+            height: odd.height(),
+            background_width: width,
+            background_height: height,
+        });
+    }
+    // A histogram per byte would cost 256 counts each; gathering the n
+    // values and selecting the middle one costs O(n).
+    let mut values = vec![0u8; frames.len()];
+    let rgb = (0..width * height * 3)
+        .map(|i| {
+            for (v, f) in values.iter_mut().zip(frames) {
+                *v = f.rgb()[i];
+            }
+            *values.select_nth_unstable(frames.len() / 2).1
+        })
+        .collect();
+    Ok(Frame::from_rgb(format!("the median of {} frames", frames.len()), width, height, rgb))
+}
+
+/// The median background of `source`: the per-pixel median of at most
+/// [`MEDIAN_SAMPLE`] frames spread evenly over it (see
+/// [`FrameSource::sample`]).
+pub fn estimate_background(source: &FrameSource) -> Result<Frame, SilhouetteError> {
+    median_background(&source.sample(MEDIAN_SAMPLE)?)
+}
+
+/// Scratch rows of the binary median filter.
+#[derive(Debug, Default)]
+struct MedianScratch {
+    /// Column counts of one output row, padded by `radius` on each side.
+    columns: Vec<u8>,
+}
+
+impl MedianScratch {
+    /// The median of a binary image over a `(2r+1)²` window: a pixel is set
+    /// when more than half the window is. Outside the image the nearest edge
+    /// pixel repeats. Counts are separable box sums, each a few whole-row
+    /// additions of bytes that compile to vector code.
+    fn filter(&mut self, input: &[u8], width: usize, height: usize, radius: usize, out: &mut [u8]) {
+        let padded = width + 2 * radius;
+        self.columns.resize(padded, 0);
+        let half = ((2 * radius + 1) * (2 * radius + 1) / 2) as u8;
+        for y in 0..height {
+            let columns = &mut self.columns[radius..radius + width];
+            columns.fill(0);
+            for dy in 0..=2 * radius {
+                let source = (y + dy).saturating_sub(radius).min(height - 1);
+                for (c, &p) in columns.iter_mut().zip(&input[source * width..(source + 1) * width]) {
+                    *c += p;
+                }
+            }
+            let (first, last) = (self.columns[radius], self.columns[radius + width - 1]);
+            self.columns[..radius].fill(first);
+            self.columns[radius + width..].fill(last);
+            let row = &mut out[y * width..(y + 1) * width];
+            row.copy_from_slice(&self.columns[..width]);
+            for dx in 1..=2 * radius {
+                for (o, &c) in row.iter_mut().zip(&self.columns[dx..dx + width]) {
+                    *o += c;
+                }
+            }
+            for o in row.iter_mut() {
+                *o = u8::from(*o > half);
+            }
+        }
+    }
+}
+
+/// A horizontal run of equal pixels, `x0..x1` on row `y`.
+#[derive(Clone, Copy, Debug)]
+struct Run {
+    y: u32,
+    x0: u32,
+    x1: u32,
+}
+
+/// Connected components over runs: union-find on the runs of one value,
+/// each run joined with the runs it touches on the row above.
+#[derive(Debug, Default)]
+struct Components {
+    runs: Vec<Run>,
+    /// Union-find parent of each run; a root's parent is itself, and a
+    /// parent's index is never above its child's.
+    parent: Vec<u32>,
+    /// Pixel count of each root's component.
+    area: Vec<u32>,
+    /// Whether each root's component touches the image's edge.
+    edge: Vec<bool>,
+}
+
+impl Components {
+    /// Clears the `value` components (8-connected) smaller than `min_area`.
+    fn remove_small(&mut self, pixels: &mut [u8], width: usize, height: usize, value: u8, min_area: u32) {
+        self.label(pixels, width, height, value, true);
+        for (run, &root) in self.runs.iter().zip(&self.parent) {
+            if self.area[root as usize] < min_area {
+                let row = run.y as usize * width;
+                pixels[row + run.x0 as usize..row + run.x1 as usize].fill(1 - value);
+            }
+        }
+    }
+
+    /// Sets the holes (4-connected unset components not touching the edge)
+    /// of at most `max_area` pixels.
+    fn fill_holes(&mut self, pixels: &mut [u8], width: usize, height: usize, max_area: u32) {
+        self.label(pixels, width, height, 0, false);
+        for (run, &root) in self.runs.iter().zip(&self.parent) {
+            if self.area[root as usize] <= max_area && !self.edge[root as usize] {
+                let row = run.y as usize * width;
+                pixels[row + run.x0 as usize..row + run.x1 as usize].fill(1);
+            }
+        }
+    }
+
+    /// Finds the runs of `value` and their components; afterwards every
+    /// run's parent is its root, and roots hold areas and edge flags.
+    fn label(&mut self, pixels: &[u8], width: usize, height: usize, value: u8, eight: bool) {
+        self.runs.clear();
+        self.parent.clear();
+        // Runs on the row above touch when their spans overlap, or for
+        // 8-connectivity also meet at a corner.
+        let reach = u32::from(eight);
+        let mut above = 0..0;
+        for y in 0..height {
+            let row = &pixels[y * width..(y + 1) * width];
+            let start = self.runs.len();
+            let mut x = 0;
+            loop {
+                x = find(row, x, value);
+                if x == width {
+                    break;
+                }
+                let end = find(row, x, 1 - value);
+                self.parent.push(self.runs.len() as u32);
+                self.runs.push(Run { y: y as u32, x0: x as u32, x1: end as u32 });
+                x = end;
+            }
+            let mut j = above.start;
+            for i in start..self.runs.len() {
+                let Run { x0, x1, .. } = self.runs[i];
+                while j < above.end && self.runs[j].x1 + reach <= x0 {
+                    j += 1;
+                }
+                let mut k = j;
+                while k < above.end && self.runs[k].x0 < x1 + reach {
+                    self.union(i, k);
+                    k += 1;
+                }
+            }
+            above = start..self.runs.len();
+        }
+        self.area.clear();
+        self.area.resize(self.runs.len(), 0);
+        self.edge.clear();
+        self.edge.resize(self.runs.len(), false);
+        let (last_row, width) = (height as u32 - 1, width as u32);
+        for i in 0..self.runs.len() {
+            // Parents come before children, so one pass in order flattens.
+            let root = self.parent[self.parent[i] as usize];
+            self.parent[i] = root;
+            let Run { y, x0, x1 } = self.runs[i];
+            self.area[root as usize] += x1 - x0;
+            self.edge[root as usize] |= y == 0 || y == last_row || x0 == 0 || x1 == width;
+        }
+    }
+
+    fn root(&mut self, mut i: usize) -> usize {
+        while self.parent[i] as usize != i {
+            let grand = self.parent[self.parent[i] as usize];
+            self.parent[i] = grand;
+            i = grand as usize;
+        }
+        i
+    }
+
+    /// Joins two components, the later root under the earlier.
+    fn union(&mut self, a: usize, b: usize) {
+        let (a, b) = (self.root(a), self.root(b));
+        let (low, high) = (a.min(b), a.max(b));
+        self.parent[high] = low as u32;
+    }
+}
+
+/// The first index at or after `from` where `row` holds `value` (0 or 1),
+/// or `row.len()`. Skips eight pixels at a time where none can match.
+fn find(row: &[u8], from: usize, value: u8) -> usize {
+    // Pixels are 0 or 1: a word of eight that all miss equals `other`.
+    let other = u64::from_ne_bytes([1 - value; 8]);
+    let mut x = from;
+    while x + 8 <= row.len() {
+        let word = u64::from_ne_bytes(row[x..x + 8].try_into().expect("eight bytes"));
+        if word != other {
+            break;
+        }
+        x += 8;
+    }
+    row[x..].iter().position(|&p| p == value).map_or(row.len(), |i| x + i)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+    use rand_distr::{Distribution, Normal};
+    use std::collections::VecDeque;
+
+    /// A textured background: stripes and blotches in several colors.
+    fn background_rgb(width: usize, height: usize) -> Vec<u8> {
+        let mut rgb = Vec::with_capacity(width * height * 3);
+        for y in 0..height {
+            for x in 0..width {
+                let blotch = ((x / 9 + y / 7) % 3) as u8 * 25;
+                rgb.push(90 + blotch + (x * 7 % 23) as u8);
+                rgb.push(110 + (y * 5 % 31) as u8 + blotch / 2);
+                rgb.push(70 + ((x + y) * 3 % 29) as u8);
+            }
+        }
+        rgb
+    }
+
+    /// Whether (x, y) is inside an ellipse of centre (cx, cy) and radii (rx, ry).
+    fn in_ellipse(x: usize, y: usize, (cx, cy): (f64, f64), (rx, ry): (f64, f64)) -> bool {
+        let (dx, dy) = ((x as f64 + 0.5 - cx) / rx, (y as f64 + 0.5 - cy) / ry);
+        dx * dx + dy * dy <= 1.0
+    }
+
+    /// A person-like shape centred at `cx`: head, body, arms, legs.
+    fn person(width: usize, height: usize, cx: f64) -> Mask {
+        let (w, h) = (width as f64, height as f64);
+        Mask::from_fn(width, height, |x, y| {
+            let (fx, fy) = (x as f64 + 0.5, y as f64 + 0.5);
+            let head = in_ellipse(x, y, (cx, 0.18 * h), (0.04 * w, 0.06 * h));
+            let body = (fx - cx).abs() < 0.06 * w && fy > 0.24 * h && fy < 0.58 * h;
+            let arms = (fx - cx).abs() < 0.16 * w && fy > 0.27 * h && fy < 0.33 * h;
+            let legs = (fx - cx).abs() > 0.01 * w && (fx - cx).abs() < 0.05 * w && fy >= 0.58 * h && fy < 0.86 * h;
+            head || body || arms || legs
+        })
+    }
+
+    /// A color frame: `person` in a shirt and dark trousers over the
+    /// background, a shadow on the ground at its feet, Gaussian noise of
+    /// `sigma` on every channel.
+    fn scene(background: &[u8], person: &Mask, cx: f64, sigma: f64, rng: &mut ChaCha8Rng) -> Frame {
+        let (width, height) = (person.width(), person.height());
+        let (w, h) = (width as f64, height as f64);
+        let noise = Normal::new(0.0, sigma).unwrap();
+        let mut rgb = background.to_vec();
+        for y in 0..height {
+            for x in 0..width {
+                let p = &mut rgb[3 * (y * width + x)..3 * (y * width + x) + 3];
+                if person.get(x, y) {
+                    let shade = ((x + 2 * y) % 11) as u8;
+                    let color = if (y as f64) < 0.58 * h { [200, 60 + shade, 50] } else { [30, 35, 70 + shade] };
+                    p.copy_from_slice(&color);
+                } else if in_ellipse(x, y, (cx + 0.08 * w, 0.86 * h), (0.16 * w, 0.04 * h)) {
+                    for c in p.iter_mut() {
+                        *c = (f64::from(*c) * 0.6).round() as u8;
+                    }
+                }
+                for c in p.iter_mut() {
+                    *c = (f64::from(*c) + noise.sample(rng)).round().clamp(0.0, 255.0) as u8;
+                }
+            }
+        }
+        Frame::from_rgb(format!("scene at {cx}"), width, height, rgb)
+    }
+
+    fn iou(a: &Mask, b: &Mask) -> f64 {
+        let both = a.pixels().iter().zip(b.pixels()).filter(|&(&p, &q)| p & q == 1).count();
+        let either = a.pixels().iter().zip(b.pixels()).filter(|&(&p, &q)| p | q == 1).count();
+        both as f64 / either as f64
+    }
+
+    #[test]
+    fn a_silhouette_frame_is_thresholded_at_128() {
+        let mut out = vec![9; 6];
+        threshold_into(&[0, 0, 0, 127, 127, 127, 128, 128, 128, 127, 128, 129, 255, 255, 255, 32, 32, 32], &mut out);
+        assert_eq!(out, [0, 0, 1, 1, 1, 0]);
+
+        let rgb = [0, 0, 0, 32, 32, 32, 224, 224, 224, 255, 255, 255, 0, 32, 0, 240, 224, 255];
+        let frame = Frame::from_rgb("silhouette", 3, 2, rgb.to_vec());
+        assert_eq!(frame.kind(), FrameKind::Silhouette);
+        // No background is needed for a silhouette.
+        let mask = Extractor::new(ExtractParams::default()).unwrap().extract(&frame).unwrap();
+        assert_eq!(mask.pixels(), &[0, 0, 1, 1, 0, 1]);
+    }
+
+    #[test]
+    fn background_subtraction_recovers_a_person_through_noise_and_shadow() {
+        let (width, height) = (160, 120);
+        let background = background_rgb(width, height);
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let truth = person(width, height, 70.0);
+        let frame = scene(&background, &truth, 70.0, 6.0, &mut rng);
+        let mut extractor = Extractor::new(ExtractParams::default()).unwrap();
+        extractor.set_background(&Frame::from_rgb("background", width, height, background.clone()));
+        let mask = extractor.extract(&frame).unwrap();
+        let score = iou(&mask, &truth);
+        assert!(score > 0.97, "IoU {score}");
+
+        // Without shadow suppression the shadow joins the silhouette.
+        let mut plain = Extractor::new(ExtractParams::default().shadow_chroma(0)).unwrap();
+        plain.set_background(&Frame::from_rgb("background", width, height, background));
+        let score = iou(&plain.extract(&frame).unwrap(), &truth);
+        assert!(score < 0.9, "IoU without shadow suppression {score}");
+    }
+
+    #[test]
+    fn the_median_background_of_frames_hides_a_moving_person() {
+        let (width, height) = (160, 120);
+        let background = background_rgb(width, height);
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let frames: Vec<_> = (0..9)
+            .map(|i| {
+                let cx = 20.0 + 15.0 * i as f64;
+                scene(&background, &person(width, height, cx), cx, 4.0, &mut rng)
+            })
+            .collect();
+        let median = median_background(&frames).unwrap();
+        let off = median.rgb().iter().zip(&background).filter(|&(&m, &b)| m.abs_diff(b) > 12).count();
+        assert!(off < width * height * 3 / 200, "{off} channels far from the background");
+
+        let mut extractor = Extractor::new(ExtractParams::default()).unwrap();
+        extractor.set_background(&median);
+        for (i, frame) in frames.iter().enumerate() {
+            let truth = person(width, height, 20.0 + 15.0 * i as f64);
+            let score = iou(&extractor.extract(frame).unwrap(), &truth);
+            assert!(score > 0.95, "frame {i}: IoU {score}");
+        }
+    }
+
+    #[test]
+    fn the_median_is_the_middle_value_of_each_channel() {
+        let frames: Vec<_> = [[10, 200, 7], [30, 100, 9], [20, 0, 8], [40, 50, 250]]
+            .iter()
+            .map(|p| Frame::from_rgb("one pixel", 1, 1, p.to_vec()))
+            .collect();
+        assert_eq!(median_background(&frames).unwrap().rgb(), &[30, 100, 9]);
+        assert_eq!(median_background(&frames[..3]).unwrap().rgb(), &[20, 100, 8]);
+        assert!(matches!(median_background(&[]), Err(SilhouetteError::NoFrames)));
+        let odd = [frames[0].clone(), Frame::from_rgb("wide", 2, 1, vec![0; 6])];
+        let message = median_background(&odd).unwrap_err().to_string();
+        assert_eq!(message, "wide: the frame is 2×1; the background is 1×1");
+    }
+
+    #[test]
+    fn a_frame_of_another_size_than_the_background_is_an_error() {
+        let mut extractor = Extractor::new(ExtractParams::default()).unwrap();
+        let frame = Frame::from_rgb("frame 7", 8, 6, background_rgb(8, 6));
+        let message = extractor.extract(&frame).unwrap_err().to_string();
+        assert_eq!(message, "frame 7: a color frame, and no background to subtract was given");
+        extractor.set_background(&Frame::from_rgb("background", 8, 5, background_rgb(8, 5)));
+        let message = extractor.extract(&frame).unwrap_err().to_string();
+        assert_eq!(message, "frame 7: the frame is 8×6; the background is 8×5");
+    }
+
+    #[test]
+    fn settings_out_of_range_are_refused() {
+        let new = |p: ExtractParams| Extractor::new(p).map(|_| ()).unwrap_err();
+        let p = ExtractParams::default();
+        assert_eq!(new(p.threshold(0)), ExtractParamsError::Threshold(0));
+        assert_eq!(new(p.threshold(765)), ExtractParamsError::Threshold(765));
+        assert_eq!(new(p.shadow_ratio(0.0, 0.9)), ExtractParamsError::ShadowRatio { low: 0.0, high: 0.9 });
+        assert_eq!(new(p.shadow_ratio(0.8, 0.7)), ExtractParamsError::ShadowRatio { low: 0.8, high: 0.7 });
+        assert_eq!(new(p.shadow_ratio(0.5, 1.0)), ExtractParamsError::ShadowRatio { low: 0.5, high: 1.0 });
+        assert_eq!(new(p.shadow_chroma(766)), ExtractParamsError::ShadowChroma(766));
+        assert_eq!(new(p.median_radius(8)), ExtractParamsError::MedianRadius(8));
+        assert_eq!(new(p.min_blob(1.0)), ExtractParamsError::MinBlob(1.0));
+        assert!(matches!(new(p.max_hole(f64::NAN)), ExtractParamsError::MaxHole(_)));
+        assert!(Extractor::new(p.median_radius(7).min_blob(0.0).max_hole(0.0).shadow_chroma(0)).is_ok());
+    }
+
+    /// Random binary masks of many shapes and densities.
+    fn random_masks(seed: u64) -> Vec<(usize, usize, Vec<u8>)> {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        (0..300)
+            .map(|_| {
+                let (width, height) = (rng.gen_range(1..40), rng.gen_range(1..30));
+                let density = rng.gen_range(0.05..0.95);
+                (width, height, (0..width * height).map(|_| u8::from(rng.gen_bool(density))).collect())
+            })
+            .collect()
+    }
+
+    fn median_reference(input: &[u8], width: usize, height: usize, radius: usize) -> Vec<u8> {
+        let r = radius as isize;
+        let clamp = |v: isize, n: usize| v.clamp(0, n as isize - 1) as usize;
+        let mut out = vec![0; width * height];
+        for y in 0..height {
+            for x in 0..width {
+                let mut count = 0;
+                for dy in -r..=r {
+                    for dx in -r..=r {
+                        count +=
+                            usize::from(input[clamp(y as isize + dy, height) * width + clamp(x as isize + dx, width)]);
+                    }
+                }
+                out[y * width + x] = u8::from(2 * count > (2 * radius + 1).pow(2));
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn the_median_filter_matches_a_brute_force_count() {
+        let mut scratch = MedianScratch::default();
+        for (i, (width, height, input)) in random_masks(1).into_iter().enumerate() {
+            let radius = i % (MAX_MEDIAN_RADIUS + 1);
+            let mut out = vec![7; width * height];
+            scratch.filter(&input, width, height, radius, &mut out);
+            assert_eq!(out, median_reference(&input, width, height, radius), "{width}×{height}, radius {radius}");
+        }
+        // A lone pixel goes, a lone gap is filled, a straight edge stays.
+        let input = Mask::from_fn(7, 5, |x, y| (x >= 3 && !(x == 5 && y == 2)) || (x == 1 && y == 2));
+        let mut out = vec![0; 35];
+        scratch.filter(input.pixels(), 7, 5, 1, &mut out);
+        assert_eq!(out, Mask::from_fn(7, 5, |x, _| x >= 3).pixels());
+    }
+
+    /// The components of `value` by flood fill: (pixel indices, touches the edge).
+    fn components_reference(
+        pixels: &[u8],
+        width: usize,
+        height: usize,
+        value: u8,
+        eight: bool,
+    ) -> Vec<(Vec<usize>, bool)> {
+        let mut seen = vec![false; pixels.len()];
+        let mut components = Vec::new();
+        for start in 0..pixels.len() {
+            if seen[start] || pixels[start] != value {
+                continue;
+            }
+            seen[start] = true;
+            let (mut members, mut edge, mut queue) = (Vec::new(), false, VecDeque::from([start]));
+            while let Some(i) = queue.pop_front() {
+                members.push(i);
+                let (x, y) = ((i % width) as isize, (i / width) as isize);
+                edge |= x == 0 || y == 0 || x == width as isize - 1 || y == height as isize - 1;
+                for (dx, dy) in [(-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1)] {
+                    let (nx, ny) = (x + dx, y + dy);
+                    let diagonal = dx != 0 && dy != 0;
+                    if (diagonal && !eight) || nx < 0 || ny < 0 || nx >= width as isize || ny >= height as isize {
+                        continue;
+                    }
+                    let j = ny as usize * width + nx as usize;
+                    if !seen[j] && pixels[j] == value {
+                        seen[j] = true;
+                        queue.push_back(j);
+                    }
+                }
+            }
+            components.push((members, edge));
+        }
+        components
+    }
+
+    #[test]
+    fn blob_removal_and_hole_filling_match_a_flood_fill() {
+        let mut components = Components::default();
+        for (i, (width, height, input)) in random_masks(2).into_iter().enumerate() {
+            let min_area = 1 + (i % 9) as u32;
+            let mut expected = input.clone();
+            for (members, _) in components_reference(&input, width, height, 1, true) {
+                if members.len() < min_area as usize {
+                    members.iter().for_each(|&j| expected[j] = 0);
+                }
+            }
+            let mut out = input.clone();
+            components.remove_small(&mut out, width, height, 1, min_area);
+            assert_eq!(out, expected, "{width}×{height}, blobs under {min_area} removed");
+
+            let max_hole = (i % 7) as u32;
+            for (members, edge) in components_reference(&out, width, height, 0, false) {
+                if !edge && members.len() <= max_hole as usize {
+                    members.iter().for_each(|&j| expected[j] = 1);
+                }
+            }
+            components.fill_holes(&mut out, width, height, max_hole);
+            assert_eq!(out, expected, "{width}×{height}, holes up to {max_hole} filled");
+        }
+    }
+
+    #[test]
+    fn blobs_touching_at_a_corner_are_one_and_holes_open_at_a_corner_are_not() {
+        // Two 2×2 squares meeting at a corner make one blob of 8 pixels.
+        let squares = Mask::from_fn(6, 6, |x, y| {
+            (1..3).contains(&x) && (1..3).contains(&y) || (3..5).contains(&x) && (3..5).contains(&y)
+        });
+        let mut pixels = squares.pixels().to_vec();
+        Components::default().remove_small(&mut pixels, 6, 6, 1, 8);
+        assert_eq!(pixels, squares.pixels());
+        Components::default().remove_small(&mut pixels, 6, 6, 1, 9);
+        assert!(pixels.iter().all(|&p| p == 0));
+        // A ring with a one-pixel hole is closed; a ring broken at the edge is not.
+        let ring = Mask::from_fn(5, 5, |x, y| (1..4).contains(&x) && (1..4).contains(&y) && (x, y) != (2, 2));
+        let mut pixels = ring.pixels().to_vec();
+        Components::default().fill_holes(&mut pixels, 5, 5, 1);
+        assert_eq!(pixels, Mask::from_fn(5, 5, |x, y| (1..4).contains(&x) && (1..4).contains(&y)).pixels());
+        let open = Mask::from_fn(3, 3, |x, y| (x, y) != (1, 1) && (x, y) != (1, 0));
+        let mut pixels = open.pixels().to_vec();
+        Components::default().fill_holes(&mut pixels, 3, 3, 5);
+        assert_eq!(pixels, open.pixels());
+    }
+
+    #[test]
+    fn extracting_again_reuses_the_buffers() {
+        let (width, height) = (64, 48);
+        let background = background_rgb(width, height);
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut extractor = Extractor::new(ExtractParams::default()).unwrap();
+        extractor.set_background(&Frame::from_rgb("background", width, height, background.clone()));
+        let mut out = Mask::new(width, height);
+        let frames: Vec<_> = [20.0, 30.0, 40.0]
+            .iter()
+            .map(|&cx| scene(&background, &person(width, height, cx), cx, 3.0, &mut rng))
+            .collect();
+        extractor.extract_into(&frames[0], &mut out).unwrap();
+        let buffers = |e: &Extractor, out: &Mask| {
+            (e.raw.as_ptr(), e.median.columns.as_ptr(), e.components.runs.as_ptr(), out.pixels().as_ptr())
+        };
+        let before = buffers(&extractor, &out);
+        for frame in &frames {
+            extractor.extract_into(frame, &mut out).unwrap();
+            assert_eq!(buffers(&extractor, &out), before);
+            assert_eq!(out, extractor.extract(frame).unwrap());
+        }
+    }
+
+    #[test]
+    fn find_locates_the_next_pixel_of_a_value() {
+        let row: Vec<u8> = (0..37).map(|i| u8::from(i == 0 || i == 20 || i == 36)).collect();
+        assert_eq!((find(&row, 0, 1), find(&row, 1, 1), find(&row, 21, 1), find(&row, 37, 1)), (0, 20, 36, 37));
+        assert_eq!((find(&row, 0, 0), find(&row, 20, 0)), (1, 21));
+        assert_eq!(find(&[1; 17], 0, 0), 17);
+    }
+}
