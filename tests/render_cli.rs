@@ -1,5 +1,6 @@
 //! `imitate render`: silhouette frames, the camera and the ground truth,
-//! the same bytes every time, and bad input refused with nothing written.
+//! color frames and noise, the same bytes every time, and bad input refused
+//! with nothing written.
 
 mod common;
 
@@ -21,17 +22,37 @@ fn render(args: &[&str], dir: &Path) -> Output {
     imitate().current_dir(dir).arg("render").args(args).arg("-q").output().unwrap()
 }
 
-/// The frames of a render folder as (width, height, pixels).
-fn frames(dir: &Path) -> Vec<(u32, u32, Vec<u8>)> {
-    let mut names: Vec<PathBuf> = fs::read_dir(dir.join("frames")).unwrap().map(|e| e.unwrap().path()).collect();
+/// The files of a folder, sorted by name.
+fn files(dir: &Path) -> Vec<PathBuf> {
+    let mut names: Vec<PathBuf> = fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).collect();
     names.sort();
     names
+}
+
+/// The frames of a render folder as (width, height, pixels).
+fn frames(dir: &Path) -> Vec<(u32, u32, Vec<u8>)> {
+    files(&dir.join("frames"))
         .iter()
         .map(|p| {
             let img = image::open(p).unwrap().into_luma8();
             (img.width(), img.height(), img.into_raw())
         })
         .collect()
+}
+
+/// An RGB PNG's size and pixels; anything but 8-bit RGB fails.
+fn rgb(path: &Path) -> (u32, u32, Vec<u8>) {
+    let img = image::open(path).unwrap();
+    assert_eq!(img.color(), image::ColorType::Rgb8, "{}", path.display());
+    let img = img.into_rgb8();
+    (img.width(), img.height(), img.into_raw())
+}
+
+/// Intersection over union of two silhouettes (0 off the body, 255 on it).
+fn iou(a: &[u8], b: &[u8]) -> f64 {
+    let both = a.iter().zip(b).filter(|(x, y)| **x > 0 && **y > 0).count();
+    let either = a.iter().zip(b).filter(|(x, y)| **x > 0 || **y > 0).count();
+    both as f64 / either as f64
 }
 
 #[test]
@@ -87,11 +108,104 @@ fn rendering_twice_on_one_or_four_threads_gives_the_same_bytes() {
     for file in ["truth.csv", "camera.json"] {
         assert_eq!(fs::read(a.join(file)).unwrap(), fs::read(b.join(file)).unwrap(), "{file}");
     }
-    let files: Vec<_> = fs::read_dir(a.join("frames")).unwrap().map(|e| e.unwrap().path()).collect();
-    for f in files {
+    for f in files(&a.join("frames")) {
         let same = fs::read(&f).unwrap() == fs::read(b.join("frames").join(f.file_name().unwrap())).unwrap();
         assert!(same, "{}", f.display());
     }
+}
+
+#[test]
+fn color_frames_show_the_body_over_the_empty_room_of_background_png() {
+    let tmp = tempfile::tempdir().unwrap();
+    let take = mocap("wave-h.bvh");
+    let take = take.to_str().unwrap();
+    for (name, extra) in [("color", &["--color"][..]), ("plain", &[]), ("clean", &["--noise", "none"])] {
+        let out = render(&[&[take, "-o", name, "--size", "96x72"], extra].concat(), tmp.path());
+        assert!(out.status.success(), "{}", stderr_of(&out));
+    }
+    let (run, clean) = (tmp.path().join("color"), frames(&tmp.path().join("clean")));
+    // The silhouettes are the same with or without --color.
+    assert_eq!(frames(&run), frames(&tmp.path().join("plain")));
+    assert!(!tmp.path().join("plain/color").exists() && !tmp.path().join("plain/background.png").exists());
+    let (w, h, background) = rgb(&run.join("background.png"));
+    assert_eq!((w, h), (96, 72));
+    let colors = files(&run.join("color"));
+    assert_eq!(colors.len(), clean.len());
+    for (k, (path, (_, _, body))) in colors.iter().zip(&clean).enumerate() {
+        assert_eq!(path.file_name().unwrap().to_str().unwrap(), format!("{k:06}.png"));
+        let (w, h, pixels) = rgb(path);
+        assert_eq!((w, h), (96, 72));
+        // Summed over R, G and B, body pixels differ from the room by far
+        // more than the sensor's noise, and the rest (the shadow at the
+        // feet aside) hardly at all.
+        let differ =
+            |p: usize| (0..3).map(|c| u32::from(pixels[3 * p + c].abs_diff(background[3 * p + c]))).sum::<u32>();
+        let on: Vec<u32> = (0..body.len()).filter(|&p| body[p] > 0).map(differ).collect();
+        let off: Vec<u32> = (0..body.len()).filter(|&p| body[p] == 0).map(differ).collect();
+        let clear = on.iter().filter(|&&d| d > 60).count();
+        assert!(clear as f64 >= 0.98 * on.len() as f64, "frame {k}: {clear} of {} body pixels stand out", on.len());
+        let close = off.iter().filter(|&&d| d <= 20).count();
+        assert!(close as f64 >= 0.97 * off.len() as f64, "frame {k}: {close} of {} others near the room", off.len());
+    }
+}
+
+#[test]
+fn each_noise_level_spoils_the_silhouette_by_a_bounded_amount() {
+    let tmp = tempfile::tempdir().unwrap();
+    let take = mocap("punch.bvh");
+    // Levels by name or number; heavy also has boxes passing in front.
+    for level in ["none", "light", "2", "heavy"] {
+        let out = render(&[take.to_str().unwrap(), "-o", level, "--noise", level], tmp.path());
+        assert!(out.status.success(), "{}", stderr_of(&out));
+    }
+    let clean = frames(&tmp.path().join("none"));
+    let mut previous = 1.0;
+    for (level, low, high) in [("light", 0.9, 0.99), ("2", 0.78, 0.95), ("heavy", 0.6, 0.85)] {
+        let spoilt = frames(&tmp.path().join(level));
+        assert_eq!(spoilt.len(), clean.len());
+        let scores: Vec<f64> = clean.iter().zip(&spoilt).map(|(a, b)| iou(&a.2, &b.2)).collect();
+        assert!(spoilt.iter().all(|f| f.2.iter().all(|&p| p == 0 || p == 255)), "{level}: not binary");
+        let mean = scores.iter().sum::<f64>() / scores.len() as f64;
+        let worst = scores.iter().copied().fold(1.0, f64::min);
+        assert!(mean >= low && mean <= high && mean < previous, "{level}: mean IoU {mean}");
+        assert!(worst >= low - 0.2, "{level}: worst IoU {worst}");
+        previous = mean;
+    }
+}
+
+#[test]
+fn one_seed_gives_the_same_bytes_on_one_or_four_threads_and_another_seed_other_frames() {
+    let tmp = tempfile::tempdir().unwrap();
+    let take = mocap("twist.bvh");
+    for (threads, name, seed) in [("1", "a", "5"), ("4", "b", "5"), ("4", "c", "6")] {
+        let out = imitate()
+            .current_dir(tmp.path())
+            .env("RAYON_NUM_THREADS", threads)
+            .args(["render", take.to_str().unwrap(), "-o", name, "--size", "96x72", "--color", "--noise", "heavy"])
+            .args(["--seed", seed, "-q"])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", stderr_of(&out));
+    }
+    let (a, b, c) = (tmp.path().join("a"), tmp.path().join("b"), tmp.path().join("c"));
+    let every = |dir: &Path| {
+        let mut all = files(dir);
+        all.extend(files(&dir.join("frames")));
+        all.extend(files(&dir.join("color")));
+        all.retain(|p| p.is_file());
+        all
+    };
+    let (ours, theirs) = (every(&a), every(&b));
+    assert_eq!(ours.len(), theirs.len());
+    assert!(ours.len() > 2 * 170, "{} files", ours.len());
+    for (x, y) in ours.iter().zip(&theirs) {
+        assert_eq!(x.strip_prefix(&a).unwrap(), y.strip_prefix(&b).unwrap());
+        assert!(fs::read(x).unwrap() == fs::read(y).unwrap(), "{}", x.display());
+    }
+    // Another seed: another room and other noise in every frame.
+    assert_ne!(fs::read(a.join("background.png")).unwrap(), fs::read(c.join("background.png")).unwrap());
+    let (first, second) = (frames(&a), frames(&c));
+    assert!(first.iter().zip(&second).all(|(x, y)| x != y));
 }
 
 #[test]
@@ -146,6 +260,8 @@ fn bad_input_is_refused_with_nothing_written() {
     refused(dir, &[take, "-o", "out", "--size", "0x120"], 2, "`width` is 0");
     refused(dir, &[take, "-o", "out", "--fps", "0"], 2, "--fps 0");
     refused(dir, &[take, "-o", "out", "--camera", "fisheye"], 2, "neither a preset");
+    refused(dir, &[take, "-o", "out", "--noise", "loud"], 2, "--noise");
+    refused(dir, &[take, "-o", "out", "--noise", "4"], 2, "expected none, light, medium or heavy");
     let mut spec = Camera::preset(imitate::vision::camera::Preset::Front, 160, 120).unwrap().spec().clone();
     spec.up = [0.0, 0.0, 1.0];
     fs::write(dir.join("along.json"), serde_json::to_string(&spec).unwrap()).unwrap();

@@ -9,7 +9,9 @@ use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use imitate::fsutil::{write_atomic, write_dir_atomic};
 use imitate::mocap::pose::Motion;
 use imitate::vision::camera::{Camera, Preset};
+use imitate::vision::color::Scene;
 use imitate::vision::mask::Mask;
+use imitate::vision::noise::{Level, Noise};
 use imitate::vision::render::draw;
 use imitate::vision::shape::capsules;
 use imitate::vision::truth;
@@ -20,10 +22,12 @@ use std::time::Instant;
 
 /// Render a BVH take (any skeleton: it is retargeted first) as binary
 /// silhouettes of the canonical body drawn as capsules, with the camera and
-/// the ground truth of every frame.
+/// the ground truth of every frame; with --color, also as color frames of
+/// the body in a room.
 ///
-/// Writes DIR/frames/000000.png … (0 outside the body, 255 on it),
-/// DIR/camera.json and DIR/truth.csv (see the README).
+/// Writes DIR/frames/000000.png … (0 outside the body, 255 on it; noisy
+/// unless --noise none), DIR/camera.json and DIR/truth.csv, and with
+/// --color DIR/color/000000.png … and DIR/background.png (see the README).
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The BVH file to render.
@@ -47,6 +51,18 @@ pub struct Args {
     /// each frame's activity.
     #[arg(long, value_name = "LABELS.csv")]
     pub labels: Option<PathBuf>,
+    /// Also write color frames (color/*.png) of the body shaded over a lit,
+    /// textured room, and the empty room (background.png).
+    #[arg(long)]
+    pub color: bool,
+    /// Noise for robustness tests: none, light, medium, heavy (or 0 to
+    /// 3). `light` is a good segmenter's output; `none` the clean render.
+    #[arg(long, default_value = "light", value_name = "LEVEL")]
+    pub noise: Level,
+    /// Seed of the noise and of the room's textures; the same seed gives
+    /// the same files.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
     #[command(flatten)]
     pub retarget: RetargetArgs,
     /// Replace the output folder if it exists.
@@ -86,13 +102,18 @@ fn take(args: &Args, global: Global) -> anyhow::Result<(Motion, Option<Vec<Strin
     Ok((recording.motion, names))
 }
 
-/// One frame as an 8-bit grey PNG: 0 outside, 255 on the body. Fast
-/// compression: binary frames compress well whatever the level.
+/// One frame as an 8-bit grey PNG: 0 outside, 255 on the body.
 fn png(mask: &Mask) -> Vec<u8> {
     let grey: Vec<u8> = mask.pixels().iter().map(|&p| p * 255).collect();
-    let mut out = Vec::with_capacity(grey.len() / 8);
+    encode(&grey, mask.width(), mask.height(), image::ExtendedColorType::L8)
+}
+
+/// Pixels as a PNG, compressed fast: binary frames compress well whatever
+/// the level, and noisy color frames hardly at all.
+fn encode(pixels: &[u8], width: usize, height: usize, kind: image::ExtendedColorType) -> Vec<u8> {
+    let mut out = Vec::with_capacity(pixels.len() / 4);
     PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Sub)
-        .write_image(&grey, mask.width() as u32, mask.height() as u32, image::ExtendedColorType::L8)
+        .write_image(pixels, width as u32, height as u32, kind)
         .expect("encoding to memory cannot fail");
     out
 }
@@ -113,23 +134,39 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let (motion, labels) = take(&args, global)?;
     let times: Vec<f64> = (0..).map(|k| k as f64 / args.fps).take_while(|&t| t <= motion.duration_s() + 1e-9).collect();
     let bar = progress(global, times.len() as u64, "render");
+    let noise = Noise::new(args.noise, args.seed, &camera, times.len(), args.fps);
+    let scene = args.color.then(|| Scene::new(&camera, args.seed));
     let output = args.output.display().to_string();
     let io = |e: std::io::Error| anyhow::anyhow!("{output}: cannot write: {e}");
+    let (width, height) = (camera.width(), camera.height());
     write_dir_atomic(
         &args.output,
         |dir| {
             let frames = dir.join("frames");
             std::fs::create_dir(&frames).map_err(io)?;
+            let color = dir.join("color");
+            if let Some(scene) = &scene {
+                std::fs::create_dir(&color).map_err(io)?;
+                let room = encode(scene.background(), width, height, image::ExtendedColorType::Rgb8);
+                std::fs::write(dir.join("background.png"), room).map_err(io)?;
+            }
             let rows: Vec<String> = times
                 .par_iter()
                 .enumerate()
                 .map_init(
-                    || Mask::new(camera.width(), camera.height()),
+                    || Mask::new(width, height),
                     |mask, (k, &t)| {
                         let pose = motion.pose_at(t);
                         let world = motion.body.forward(&pose);
+                        let parts = capsules(&motion.body, &world);
                         mask.clear();
-                        draw(&camera, &capsules(&motion.body, &world), mask);
+                        draw(&camera, &parts, mask);
+                        if let Some(scene) = &scene {
+                            let rgb = scene.shade(k, &world, &parts, mask, &noise);
+                            let encoded = encode(&rgb, width, height, image::ExtendedColorType::Rgb8);
+                            std::fs::write(color.join(format!("{k:06}.png")), encoded)?;
+                        }
+                        noise.apply(k, &world, mask);
                         std::fs::write(frames.join(format!("{k:06}.png")), png(mask))?;
                         bar.inc(1);
                         let source = ((t / motion.frame_time_s).round() as usize).min(motion.poses.len() - 1);
@@ -154,12 +191,12 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     note(
         global,
         &format!(
-            "{}: {} frames at {} Hz, {}×{} → {output} in {seconds:.2} s ({:.0} frames/s)",
+            "{}: {} frames at {} Hz, {width}×{height}, noise {}{} → {output} in {seconds:.2} s ({:.0} frames/s)",
             args.input.display(),
             times.len(),
             args.fps,
-            camera.width(),
-            camera.height(),
+            args.noise.name(),
+            if args.color { ", color" } else { "" },
             times.len() as f64 / seconds
         ),
     );

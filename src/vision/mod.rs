@@ -2,9 +2,11 @@
 //! from frames, and the likelihood of a pose given a silhouette (eq. 8–9).
 
 pub mod camera;
+pub mod color;
 pub mod distance;
 pub mod frames;
 pub mod mask;
+pub mod noise;
 pub mod render;
 pub mod scorer;
 pub mod shape;
