@@ -3,10 +3,13 @@
 //!
 //! The library follows the pipeline: [`mocap`] (BVH, the canonical
 //! humanoid, retargeting, the procedural demonstrator), [`vocab`] (learning
-//! a vocabulary of primitives) and [`vision`] (camera, the body drawn as
-//! capsules, distance transforms and the eq. 8–9 likelihood).
+//! a vocabulary of primitives), [`vision`] (camera, the body drawn as
+//! capsules, distance transforms and the eq. 8–9 likelihood) and [`track`]
+//! (per-primitive particle filters, recognition, the virtual trajectory).
 
 pub mod fsutil;
 pub mod mocap;
+pub mod report;
+pub mod track;
 pub mod vision;
 pub mod vocab;

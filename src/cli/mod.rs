@@ -11,8 +11,10 @@ mod inspect;
 mod learn;
 mod render;
 mod retarget;
+mod score;
 mod segment;
 mod synth;
+mod track;
 mod vocab;
 
 use clap::{Parser, Subcommand};
@@ -51,6 +53,8 @@ enum Command {
     Export(export::Args),
     Vocab(vocab::Args),
     Render(render::Args),
+    Track(track::Args),
+    Score(score::Args),
 }
 
 /// How a command ended, when it did not fail outright.
@@ -78,6 +82,8 @@ pub fn main() -> ExitCode {
         Command::Export(args) => export::run(args, cli.global),
         Command::Vocab(args) => vocab::run(args, cli.global),
         Command::Render(args) => render::run(args, cli.global),
+        Command::Track(args) => track::run(args, cli.global),
+        Command::Score(args) => score::run(args, cli.global),
     };
     match result {
         Ok(Outcome::Success) => ExitCode::SUCCESS,

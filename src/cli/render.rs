@@ -77,17 +77,25 @@ fn parse_size(text: &str) -> Result<(u32, u32), UsageError> {
     Ok((w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?))
 }
 
-fn camera(args: &Args) -> anyhow::Result<Camera> {
-    let (width, height) = parse_size(&args.size)?;
-    match Preset::from_name(&args.camera) {
+/// `--camera`: a preset framed at `width × height`, or a camera.json file
+/// (which gives its own size).
+pub fn camera(choice: &str, width: u32, height: u32) -> anyhow::Result<Camera> {
+    match Preset::from_name(choice) {
         Some(preset) => Camera::preset(preset, width, height).map_err(|e| UsageError(format!("--size: {e}")).into()),
-        None if Path::new(&args.camera).is_file() => Ok(Camera::read(Path::new(&args.camera))?),
+        None if Path::new(choice).is_file() => Ok(Camera::read(Path::new(choice))?),
         None => Err(UsageError(format!(
-            "--camera {}: neither a preset (front, side, overhead) nor a camera.json file",
-            args.camera
+            "--camera {choice}: neither a preset (front, side, overhead) nor a camera.json file"
         ))
         .into()),
     }
+}
+
+/// Refuses an output folder that holds something, unless `force`.
+pub fn refuse_nonempty(output: &Path, force: bool) -> anyhow::Result<()> {
+    if !force && output.read_dir().is_ok_and(|mut d| d.next().is_some()) {
+        bail!("{}: exists and is not empty; choose another folder or pass --force to replace it", output.display());
+    }
+    Ok(())
 }
 
 /// The take and, when labelled, each of its frames' activity.
@@ -122,14 +130,9 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 1000.0) {
         return Err(UsageError(format!("--fps {}: must be above 0 and at most 1000", args.fps)).into());
     }
-    let camera = camera(&args)?;
-    let nonempty = args.output.read_dir().is_ok_and(|mut d| d.next().is_some());
-    if nonempty && !args.force {
-        bail!(
-            "{}: exists and is not empty; choose another folder or pass --force to replace it",
-            args.output.display()
-        );
-    }
+    let (width, height) = parse_size(&args.size)?;
+    let camera = camera(&args.camera, width, height)?;
+    refuse_nonempty(&args.output, args.force)?;
     let started = Instant::now();
     let (motion, labels) = take(&args, global)?;
     let times: Vec<f64> = (0..).map(|k| k as f64 / args.fps).take_while(|&t| t <= motion.duration_s() + 1e-9).collect();

@@ -51,7 +51,7 @@ pub fn row(frame: usize, time_s: f64, activity: Option<&str>, pose: &Pose, world
 }
 
 /// A CSV field: quoted when it holds a comma, quote or line break.
-fn quoted(text: &str) -> String {
+pub fn quoted(text: &str) -> String {
     if text.contains([',', '"', '\n', '\r']) { format!("\"{}\"", text.replace('"', "\"\"")) } else { text.to_string() }
 }
 

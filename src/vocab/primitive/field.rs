@@ -76,6 +76,13 @@ impl Field {
         }
     }
 
+    /// The distance from `query` to the nearest training point: how far
+    /// off the primitive's manifold it lies.
+    pub fn distance_to_data(&self, query: &[f64], scratch: &mut Vec<(usize, f64)>) -> f64 {
+        self.index.nearest(query, 1, scratch);
+        scratch.first().map_or(f64::INFINITY, |f| f.1)
+    }
+
     /// The field's unit direction at `query` (eq. 2), written into `out`;
     /// false where the neighbours' displacements cancel out.
     pub fn direction(&self, query: &[f64], out: &mut [f64]) -> bool {

@@ -89,6 +89,23 @@ impl Primitive {
         &self.sources
     }
 
+    /// The activity label most of its training segments carry (ties to the
+    /// first in name order), or `None` when none is labelled: what a
+    /// recognition of this primitive is scored as.
+    pub fn majority_label(&self) -> Option<&str> {
+        let mut counts = std::collections::BTreeMap::<&str, usize>::new();
+        for label in self.sources.iter().filter_map(|s| s.label.as_deref()) {
+            *counts.entry(label).or_default() += 1;
+        }
+        counts
+            .into_iter()
+            .fold(None, |best: Option<(&str, usize)>, (l, n)| match best {
+                Some((_, m)) if m >= n => best,
+                _ => Some((l, n)),
+            })
+            .map(|(l, _)| l)
+    }
+
     /// The training poses in latent space, their latent velocities (per
     /// second) and phases.
     pub fn field(&self) -> &Field {

@@ -1,0 +1,263 @@
+//! `imitate track`: the virtual trajectory, the activity and every
+//! primitive's probability and progress, from frames and a vocabulary.
+
+use super::render::{camera, refuse_nonempty};
+use super::{Global, Outcome, UsageError, note, progress};
+use anyhow::{Context, bail};
+use imitate::fsutil::{write_atomic, write_dir_atomic};
+use imitate::mocap::body::Joint;
+use imitate::mocap::bvh::write_bvh;
+use imitate::mocap::pose::Motion;
+use imitate::track::cone::Cone;
+use imitate::track::filter::FilterParams;
+use imitate::track::root::RootSearch;
+use imitate::track::tracker::{FrameEstimate, Recognition, TrackParams, Tracker};
+use imitate::vision::camera::Camera;
+use imitate::vision::frames::{Expect, FrameKind, FrameSource, read_image};
+use imitate::vision::mask::Mask;
+use imitate::vision::silhouette::{ExtractParams, Extractor, estimate_background};
+use imitate::vision::truth;
+use imitate::vocab::vocabulary::Vocabulary;
+use std::fmt::Write as _;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Track a person through one camera with a vocabulary of primitives: one
+/// particle filter per primitive in its latent space (bending-cone motion
+/// model), activity recognition from the estimates' likelihoods, and the
+/// virtual trajectory (the winning primitive's pose each frame).
+///
+/// Writes DIR/trajectory.bvh, DIR/frames.csv and DIR/summary.json (see the
+/// README).
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The frames: a folder of PNG or JPEG images (silhouettes or color),
+    /// or a video file (read through ffmpeg).
+    pub input: PathBuf,
+    /// The vocabulary (`imitate vocab build`).
+    #[arg(long, value_name = "FILE.vocab")]
+    pub vocab: PathBuf,
+    /// The folder to write (refused if it exists and is not empty, unless
+    /// --force).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// `front`, `side`, `overhead` (framed at the frames' size) or a
+    /// camera.json file. Default: the camera.json `render` wrote beside
+    /// the frames (in INPUT or its parent folder).
+    #[arg(long, value_name = "PRESET|camera.json")]
+    pub camera: Option<String>,
+    /// Particles per primitive.
+    #[arg(long, default_value_t = 6)]
+    pub particles: usize,
+    /// K of the bending cone: predictions along each primitive's field (1
+    /// is the straight-line model).
+    #[arg(long, default_value_t = 5)]
+    pub lookahead: usize,
+    /// Seed of every random draw; the same inputs and seed give the same
+    /// files (but summary.json's timing).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Recognize with eq. 10: each primitive's likelihood times its recent
+    /// probability, instead of eq. 7's likelihoods alone.
+    #[arg(long)]
+    pub feedback: bool,
+    /// Frames per second of the input.
+    #[arg(long, default_value_t = 15.0)]
+    pub fps: f64,
+    /// The empty scene, for color frames. Default: background.png beside
+    /// the frames (as `render --color` writes it), else the per-pixel
+    /// median of the frames.
+    #[arg(long, value_name = "IMAGE")]
+    pub background: Option<PathBuf>,
+    /// Replace the output folder if it exists.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Bending-cone noise across the axis, in steps of one frame's typical
+/// latent displacement.
+const CONE_SPREAD: f64 = 0.5;
+/// Particle weights are R to this power.
+const SHARPNESS: f64 = 8.0;
+/// Width of the manifold prior, in steps of one frame's typical latent
+/// displacement.
+const MANIFOLD: f64 = 2.0;
+/// Root refinement per frame.
+const ROOT_SEARCH: RootSearch = RootSearch { steps: 4, move_m: 0.03, turn_rad: 0.05 };
+/// Memory of eq. 10's feedback.
+const FEEDBACK_MEMORY_S: f64 = 0.5;
+
+fn params(args: &Args) -> Result<TrackParams, UsageError> {
+    if args.particles == 0 {
+        return Err(UsageError("--particles 0: a filter needs at least 1 particle".into()));
+    }
+    if args.lookahead == 0 {
+        return Err(UsageError("--lookahead 0: the bending cone needs at least 1 prediction".into()));
+    }
+    if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 1000.0) {
+        return Err(UsageError(format!("--fps {}: must be above 0 and at most 1000", args.fps)));
+    }
+    let recognition =
+        if args.feedback { Recognition::Feedback { memory_s: FEEDBACK_MEMORY_S } } else { Recognition::Likelihood };
+    let filter = FilterParams {
+        particles: args.particles,
+        cone: Cone { lookahead: args.lookahead, spread: CONE_SPREAD },
+        sharpness: SHARPNESS,
+        manifold: MANIFOLD,
+        root: ROOT_SEARCH,
+        frame_time_s: 1.0 / args.fps,
+    };
+    Ok(TrackParams { filter, recognition, seed: args.seed })
+}
+
+/// A file `render` writes beside its frames: in INPUT (a folder) or next
+/// to it.
+fn beside(input: &Path, name: &str) -> Option<PathBuf> {
+    let parent = input.parent().map(|p| p.join(name));
+    [input.is_dir().then(|| input.join(name)), parent].into_iter().flatten().find(|p| p.is_file())
+}
+
+fn choose_camera(args: &Args, source: &FrameSource) -> anyhow::Result<Camera> {
+    let camera = match (&args.camera, beside(&args.input, "camera.json")) {
+        (Some(choice), _) => camera(choice, source.width() as u32, source.height() as u32)?,
+        (None, Some(path)) => Camera::read(&path)?,
+        (None, None) => {
+            return Err(UsageError(format!(
+                "{}: no camera.json beside the frames; pass --camera (a preset or a camera.json)",
+                args.input.display()
+            ))
+            .into());
+        }
+    };
+    source.check_size(camera.width(), camera.height())?;
+    Ok(camera)
+}
+
+/// The header of `frames.csv`.
+fn header(names: &[&str]) -> String {
+    let mut columns: Vec<String> = ["frame", "time_s", "activity"].map(String::from).to_vec();
+    columns.extend(names.iter().map(|n| format!("prob_{n}")));
+    columns.extend(names.iter().map(|n| format!("progress_{n}")));
+    columns.extend(["root_x", "root_y", "root_z", "root_heading"].map(String::from));
+    columns.extend(truth::position_columns());
+    columns.iter().map(|c| truth::quoted(c)).collect::<Vec<_>>().join(",") + "\n"
+}
+
+/// One frame's row of `frames.csv`.
+fn row(frame: usize, time_s: f64, names: &[&str], estimate: &FrameEstimate, tracker: &Tracker) -> String {
+    let mut line = format!("{frame},{time_s},");
+    if estimate.probabilities.is_some() {
+        line.push_str(&truth::quoted(names[estimate.winner]));
+    }
+    for i in 0..names.len() {
+        line.push(',');
+        if let Some(p) = &estimate.probabilities {
+            write!(line, "{}", p[i]).expect("writing to a string cannot fail");
+        }
+    }
+    for e in &estimate.estimates {
+        write!(line, ",{}", e.progress).expect("writing to a string cannot fail");
+    }
+    let pose = &estimate.pose;
+    let world = tracker.body().forward(pose);
+    let numbers = [pose.root.x, pose.root.y, pose.root.z, pose.heading]
+        .into_iter()
+        .chain(Joint::ALL.iter().flat_map(|&j| world.position(j).to_array()));
+    for v in numbers {
+        write!(line, ",{v}").expect("writing to a string cannot fail");
+    }
+    line.push('\n');
+    line
+}
+
+pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
+    let params = params(&args)?;
+    refuse_nonempty(&args.output, args.force)?;
+    let vocabulary = Vocabulary::load(&args.vocab)?;
+    let mut source = FrameSource::open(&args.input, Expect::Auto)?;
+    let camera = choose_camera(&args, &source)?;
+    let mut extractor = Extractor::new(ExtractParams::default()).expect("the default settings are valid");
+    let mut background_used = None;
+    let mut tracker =
+        Tracker::new(&vocabulary, camera.clone(), params).with_context(|| args.vocab.display().to_string())?;
+    let names: Vec<&str> = vocabulary.primitives().iter().map(|p| p.name()).collect();
+    let bar = progress(global, source.frame_count().unwrap_or(0) as u64, "track");
+    let started = Instant::now();
+    let mut mask = Mask::new(camera.width(), camera.height());
+    let (mut rows, mut poses, mut coasted) = (Vec::new(), Vec::new(), 0usize);
+    let mut k = 0;
+    while let Some(frame) = source.next_frame() {
+        let frame = frame?;
+        if frame.kind() == FrameKind::Color && background_used.is_none() {
+            let (background, from) = match args.background.clone().or_else(|| beside(&args.input, "background.png")) {
+                Some(path) => (read_image(&path)?, path.display().to_string()),
+                None => (estimate_background(&source)?, "the per-pixel median of the frames".to_string()),
+            };
+            extractor.set_background(&background);
+            background_used = Some(from);
+        }
+        extractor.extract_into(&frame, &mut mask)?;
+        let estimate = tracker.step(&mask);
+        coasted += usize::from(estimate.probabilities.is_none());
+        rows.push(row(k, k as f64 / args.fps, &names, &estimate, &tracker));
+        poses.push(estimate.pose);
+        bar.inc(1);
+        k += 1;
+    }
+    bar.finish_and_clear();
+    if k == 0 {
+        bail!("{}: no frames", args.input.display());
+    }
+    let seconds = started.elapsed().as_secs_f64();
+    let evaluations = tracker.evaluations();
+    let motion = Motion { body: tracker.body().clone(), frame_time_s: 1.0 / args.fps, poses };
+    let summary = serde_json::json!({
+        "input": args.input.display().to_string(),
+        "vocabulary": {
+            "path": args.vocab.display().to_string(),
+            "checksum": vocabulary.checksum().map(|c| format!("{c:08x}")),
+        },
+        "primitives": vocabulary.primitives().iter().map(|p| serde_json::json!({
+            "name": p.name(), "label": p.majority_label(), "dims": p.dims(),
+        })).collect::<Vec<_>>(),
+        "camera": camera.spec(),
+        "background": background_used,
+        "settings": params,
+        "seed": args.seed,
+        "fps": args.fps,
+        "frames": k,
+        "coasted_frames": coasted,
+        "likelihood_evaluations": evaluations,
+        "likelihood_evaluations_per_frame": evaluations as f64 / k as f64,
+        "timing": { "seconds": seconds, "frames_per_second": k as f64 / seconds },
+    });
+    let output = args.output.display().to_string();
+    let io = |e: std::io::Error| anyhow::anyhow!("{output}: cannot write: {e}");
+    write_dir_atomic(
+        &args.output,
+        |dir| {
+            write_atomic(&dir.join("trajectory.bvh"), |w| write_bvh(&motion.to_bvh(), w)).map_err(io)?;
+            write_atomic(&dir.join("frames.csv"), |w| {
+                w.write_all(header(&names).as_bytes())?;
+                rows.iter().try_for_each(|r| w.write_all(r.as_bytes()))
+            })
+            .map_err(io)?;
+            let json = serde_json::to_string_pretty(&summary).expect("the summary serializes") + "\n";
+            std::fs::write(dir.join("summary.json"), json).map_err(io)
+        },
+        io,
+    )?;
+    note(
+        global,
+        &format!(
+            "{}: {k} frames ({coasted} without a silhouette), {} primitives × {} particles → {output} in {seconds:.2} s ({:.1} frames/s, {:.0} likelihoods/frame)",
+            args.input.display(),
+            names.len(),
+            args.particles,
+            k as f64 / seconds,
+            evaluations as f64 / k as f64
+        ),
+    );
+    Ok(Outcome::Success)
+}

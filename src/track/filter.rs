@@ -1,0 +1,219 @@
+//! One primitive's particle filter in its latent space (eq. 4).
+
+use crate::track::cone::{Cone, ConeScratch};
+use crate::track::root::{Root, RootSearch};
+use crate::vision::distance::Observation;
+use crate::vision::scorer::Scorer;
+use crate::vocab::primitive::Primitive;
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+/// Settings every primitive's filter shares.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct FilterParams {
+    pub particles: usize,
+    pub cone: Cone,
+    /// Particle weights are `R^sharpness`: R (eq. 8) varies little between
+    /// near poses, and raw R would resample almost uniformly.
+    pub sharpness: f64,
+    /// The primitive as a prior: a particle `δ` from the nearest training
+    /// pose is weighted by `exp(−½ (δ / (manifold · step))²)`, so a filter
+    /// explains the silhouette with its own kind of pose rather than any
+    /// pose its latent span can reach (which would let every primitive
+    /// explain every activity).
+    pub manifold: f64,
+    pub root: RootSearch,
+    /// Seconds between frames.
+    pub frame_time_s: f64,
+}
+
+/// What a filter makes of one frame.
+#[derive(Clone, Debug)]
+pub struct Estimate {
+    /// The latent pose estimate `ȳ_i[t]` and its joint-space pose.
+    pub latent: Vec<f64>,
+    pub root: Root,
+    pub x: crate::mocap::body::JointVector,
+    /// R of the estimate (eq. 8), or `None` on a frame with no silhouette.
+    pub likelihood: Option<f64>,
+    /// Attractor progress of the estimate, in [0, 1).
+    pub progress: f64,
+}
+
+/// The particles of one primitive and its global root.
+pub struct Filter<'v> {
+    primitive: &'v Primitive,
+    params: FilterParams,
+    /// Row-major, `particles × dims`.
+    particles: Vec<f64>,
+    weights: Vec<f64>,
+    root: Root,
+    rng: ChaCha8Rng,
+    scorer: Scorer,
+    cone: ConeScratch,
+    /// Likelihood evaluations made so far.
+    evaluations: u64,
+}
+
+impl<'v> Filter<'v> {
+    /// A filter whose particles start at random training poses of the
+    /// primitive (its manifold is the prior), with root `root`.
+    pub fn new(
+        primitive: &'v Primitive,
+        params: FilterParams,
+        root: Root,
+        scorer: Scorer,
+        mut rng: ChaCha8Rng,
+    ) -> Self {
+        let (d, field) = (primitive.dims(), primitive.field());
+        let mut particles = Vec::with_capacity(params.particles * d);
+        for _ in 0..params.particles {
+            let i = rng.gen_range(0..field.len());
+            particles.extend_from_slice(&field.points()[i * d..(i + 1) * d]);
+        }
+        let weights = vec![1.0 / params.particles as f64; params.particles];
+        Filter {
+            primitive,
+            params,
+            particles,
+            weights,
+            root,
+            rng,
+            scorer,
+            cone: ConeScratch::default(),
+            evaluations: 0,
+        }
+    }
+
+    pub fn primitive(&self) -> &Primitive {
+        self.primitive
+    }
+
+    pub fn set_root(&mut self, root: Root) {
+        self.root = root;
+    }
+
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+
+    /// One latent step of the primitive at the typical speed over a frame.
+    fn step_length(&self) -> f64 {
+        self.primitive.speed().median * self.params.frame_time_s
+    }
+
+    fn score(&mut self, observation: &Observation, y: &[f64], root: &Root) -> f64 {
+        self.evaluations += 1;
+        self.scorer.score(observation, &root.pose(&self.primitive.reconstruct(y)))
+    }
+
+    /// Chooses the heading (of `candidates`, each with its prior) and the
+    /// particle that best explain the first frame, then hill-climbs the
+    /// root with that particle's pose for `climb` steps.
+    pub fn place(&mut self, observation: &Observation, candidates: &[(f64, f64)], climb: usize) {
+        let d = self.primitive.dims();
+        let mut best = (f64::MIN, f64::MIN, self.root, 0);
+        for &(heading, prior) in candidates {
+            let root = Root { heading, ..self.root };
+            for j in 0..self.params.particles {
+                let y = self.particles[j * d..(j + 1) * d].to_vec();
+                let s = self.score(observation, &y, &root);
+                if s * prior > best.0 {
+                    best = (s * prior, s, root, j);
+                }
+            }
+        }
+        let (_, score, mut root, j) = best;
+        let x = self.primitive.reconstruct(&self.particles[j * d..(j + 1) * d]);
+        let search = RootSearch { steps: climb, ..self.params.root };
+        search.refine(&mut root, &x, score, observation, &mut self.scorer, &mut self.rng);
+        self.evaluations += climb as u64;
+        self.root = root;
+    }
+
+    /// One frame: every particle moves through the bending cone; with an
+    /// observation it is weighted by its likelihood, the estimate is the
+    /// better of the weighted mean and the best particle, the root is
+    /// refined for it, and the particles are resampled. Without one (an
+    /// empty silhouette) the filter coasts: the particles move and the
+    /// estimate is their mean.
+    pub fn step(&mut self, observation: Option<&Observation>) -> Estimate {
+        let (d, n) = (self.primitive.dims(), self.params.particles);
+        let step = self.step_length();
+        for j in 0..n {
+            let y = &mut self.particles[j * d..(j + 1) * d];
+            self.params.cone.sample(self.primitive, step, y, &mut self.rng, &mut self.cone);
+        }
+        let Some(observation) = observation else {
+            self.weights.fill(1.0 / n as f64);
+            let latent = self.mean();
+            return self.estimate(latent, None);
+        };
+        let root = self.root;
+        let mut scores = vec![0.0; n];
+        for (j, s) in scores.iter_mut().enumerate() {
+            let y = self.particles[j * d..(j + 1) * d].to_vec();
+            *s = self.score(observation, &y, &root);
+        }
+        // Weights relative to the best score, so the power cannot underflow all.
+        let top = scores.iter().copied().fold(f64::MIN, f64::max);
+        let width = self.params.manifold * step;
+        let mut nearest = Vec::with_capacity(1);
+        for (j, (w, s)) in self.weights.iter_mut().zip(&scores).enumerate() {
+            let off = self.primitive.field().distance_to_data(&self.particles[j * d..(j + 1) * d], &mut nearest);
+            *w = (s / top).powf(self.params.sharpness) * (-0.5 * (off / width).powi(2)).exp();
+        }
+        let total: f64 = self.weights.iter().sum();
+        self.weights.iter_mut().for_each(|w| *w /= total);
+        let best = (0..n).fold(0, |b, j| if self.weights[j] > self.weights[b] { j } else { b });
+        let mean = self.mean();
+        let mean_score = self.score(observation, &mean, &root);
+        let (latent, score) = if mean_score >= scores[best] {
+            (mean, mean_score)
+        } else {
+            (self.particles[best * d..(best + 1) * d].to_vec(), scores[best])
+        };
+        let x = self.primitive.reconstruct(&latent);
+        let mut root = self.root;
+        let score = self.params.root.refine(&mut root, &x, score, observation, &mut self.scorer, &mut self.rng);
+        self.evaluations += self.params.root.steps as u64;
+        self.root = root;
+        self.resample();
+        self.estimate(latent, Some(score))
+    }
+
+    fn estimate(&self, latent: Vec<f64>, likelihood: Option<f64>) -> Estimate {
+        let x = self.primitive.reconstruct(&latent);
+        let progress = self.primitive.progress(&latent);
+        Estimate { latent, root: self.root, x, likelihood, progress }
+    }
+
+    /// The weighted mean of the particles.
+    fn mean(&self) -> Vec<f64> {
+        let d = self.primitive.dims();
+        let mut mean = vec![0.0; d];
+        for (y, w) in self.particles.chunks_exact(d).zip(&self.weights) {
+            mean.iter_mut().zip(y).for_each(|(m, v)| *m += w * v);
+        }
+        mean
+    }
+
+    /// Systematic resampling: one uniform draw, `n` evenly spaced pointers
+    /// into the weights' running sum; low variance, and `O(n)`.
+    fn resample(&mut self) {
+        let (d, n) = (self.primitive.dims(), self.params.particles);
+        let start: f64 = self.rng.gen_range(0.0..1.0 / n as f64);
+        let mut next = Vec::with_capacity(n * d);
+        let (mut j, mut cumulative) = (0, self.weights[0]);
+        for k in 0..n {
+            let pointer = start + k as f64 / n as f64;
+            while pointer > cumulative && j + 1 < n {
+                j += 1;
+                cumulative += self.weights[j];
+            }
+            next.extend_from_slice(&self.particles[j * d..(j + 1) * d]);
+        }
+        self.particles = next;
+        self.weights.fill(1.0 / n as f64);
+    }
+}

@@ -1,0 +1,98 @@
+//! The global root (pelvis position and heading) each primitive's filter
+//! keeps apart from its latent pose, as in the paper: placed from the
+//! silhouette, then refined by Gaussian steps kept only when the
+//! likelihood rises.
+
+use crate::mocap::body::JointVector;
+use crate::mocap::pose::Pose;
+use crate::vision::camera::Camera;
+use crate::vision::distance::Observation;
+use crate::vision::mask::Mask;
+use crate::vision::scorer::Scorer;
+use glam::DVec3;
+use rand::Rng;
+use rand_distr::StandardNormal;
+
+/// The pelvis's world position (m) and the body's turn about +Y (rad).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Root {
+    pub position: DVec3,
+    pub heading: f64,
+}
+
+/// Gaussian step sizes of the root search.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct RootSearch {
+    /// Hill-climbing steps per frame.
+    pub steps: usize,
+    /// Standard deviation of a step's move, meters.
+    pub move_m: f64,
+    /// Standard deviation of a step's turn, radians.
+    pub turn_rad: f64,
+}
+
+impl Root {
+    /// Where a standing person's pelvis is, from their silhouette: the ray
+    /// through the silhouette's centre column at its lowest row meets the
+    /// floor (y = 0) at the feet, and the pelvis stands `pelvis_height`
+    /// above them. Where that ray misses the floor (a camera looking up),
+    /// the person is put at the distance of the camera's `look_at`.
+    /// `None` for an empty silhouette.
+    pub fn from_silhouette(camera: &Camera, mask: &Mask, pelvis_height: f64, heading: f64) -> Option<Root> {
+        let (mut count, mut sum_x, mut bottom) = (0usize, 0usize, 0usize);
+        for (y, row) in mask.pixels().chunks_exact(mask.width()).enumerate() {
+            let n = row.iter().filter(|&&p| p != 0).count();
+            if n > 0 {
+                count += n;
+                sum_x += row.iter().enumerate().filter(|(_, p)| **p != 0).map(|(x, _)| x).sum::<usize>();
+                bottom = y;
+            }
+        }
+        if count == 0 {
+            return None;
+        }
+        let u = sum_x as f64 / count as f64 + 0.5;
+        let origin = camera.position();
+        let ray = camera.ray(u, bottom as f64 + 1.0);
+        let feet = if ray.y < -1e-6 {
+            origin + ray * (-origin.y / ray.y)
+        } else {
+            let look_at = DVec3::from_array(camera.spec().look_at);
+            origin + ray * (look_at - origin).length()
+        };
+        Some(Root { position: DVec3::new(feet.x, pelvis_height, feet.z), heading })
+    }
+
+    /// The pose with this root and joint-space vector `x`.
+    pub fn pose(&self, x: &JointVector) -> Pose {
+        Pose { root: self.position, heading: self.heading, x: *x }
+    }
+}
+
+impl RootSearch {
+    /// Hill-climbs `root` for the joint-space pose `x`, which scores
+    /// `score` there: `steps` Gaussian moves (one likelihood evaluation
+    /// each), each kept when it scores higher. Returns the final score.
+    pub fn refine(
+        &self,
+        root: &mut Root,
+        x: &JointVector,
+        mut score: f64,
+        observation: &Observation,
+        scorer: &mut Scorer,
+        rng: &mut impl Rng,
+    ) -> f64 {
+        for _ in 0..self.steps {
+            let mut gauss = || rng.sample::<f64, _>(StandardNormal);
+            let candidate = Root {
+                position: root.position + DVec3::new(gauss(), gauss(), gauss()) * self.move_m,
+                heading: root.heading + gauss() * self.turn_rad,
+            };
+            let s = scorer.score(observation, &candidate.pose(x));
+            if s > score {
+                (*root, score) = (candidate, s);
+            }
+        }
+        score
+    }
+}

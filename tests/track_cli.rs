@@ -1,0 +1,143 @@
+//! `imitate track`: the run folder's files and their columns, the same
+//! bytes for the same seed on any thread count, coasting over a frame with
+//! no silhouette, and bad input refused with nothing written.
+
+mod common;
+
+use common::imitate;
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+fn shipped(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
+}
+
+fn run(dir: &Path, args: &[&str], threads: &str) -> Output {
+    imitate().current_dir(dir).env("RAYON_NUM_THREADS", threads).args(args).arg("-q").output().unwrap()
+}
+
+fn ok(out: Output) -> Output {
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    out
+}
+
+/// A rendered video of the shipped horizontal waving in `dir/video`.
+fn video(dir: &Path) -> PathBuf {
+    let take = shipped("mocap/wave-h.bvh");
+    let labels = shipped("mocap/labels.csv");
+    ok(run(dir, &["render", take.to_str().unwrap(), "-o", "video", "--labels", labels.to_str().unwrap()], "2"));
+    dir.join("video")
+}
+
+/// summary.json without its `timing`, the one part that differs run to run.
+fn summary_without_timing(run: &Path) -> serde_json::Value {
+    let mut summary: serde_json::Value = serde_json::from_slice(&fs::read(run.join("summary.json")).unwrap()).unwrap();
+    summary.as_object_mut().unwrap().remove("timing").expect("summary.json reports its timing");
+    summary
+}
+
+#[test]
+fn a_video_tracks_to_a_trajectory_frames_table_and_summary_the_same_on_one_or_four_threads() {
+    let tmp = tempfile::tempdir().unwrap();
+    let video = video(tmp.path());
+    let vocab = shipped("vocab/default.vocab");
+    let frames = video.join("frames");
+    for (threads, name) in [("1", "a"), ("4", "b")] {
+        let args = ["track", frames.to_str().unwrap(), "--vocab", vocab.to_str().unwrap(), "-o", name, "--seed", "3"];
+        ok(run(tmp.path(), &args, threads));
+    }
+    let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
+    for file in ["trajectory.bvh", "frames.csv"] {
+        assert_eq!(fs::read(a.join(file)).unwrap(), fs::read(b.join(file)).unwrap(), "{file}");
+    }
+    assert_eq!(summary_without_timing(&a), summary_without_timing(&b));
+
+    let table = fs::read_to_string(a.join("frames.csv")).unwrap();
+    let truth = fs::read_to_string(video.join("truth.csv")).unwrap();
+    let header: Vec<&str> = table.lines().next().unwrap().split(',').collect();
+    let summary = summary_without_timing(&a);
+    let names: Vec<&str> =
+        summary["primitives"].as_array().unwrap().iter().map(|p| p["name"].as_str().unwrap()).collect();
+    let mut expected: Vec<String> = ["frame", "time_s", "activity"].map(String::from).to_vec();
+    expected.extend(names.iter().map(|n| format!("prob_{n}")));
+    expected.extend(names.iter().map(|n| format!("progress_{n}")));
+    // Root and joint positions named as in truth.csv.
+    let truth_header: Vec<&str> = truth.lines().next().unwrap().split(',').collect();
+    expected.extend(truth_header[3..7 + 17 * 3].iter().map(|c| c.to_string()));
+    assert_eq!(header, expected);
+    assert_eq!(table.lines().count(), truth.lines().count(), "one row per frame");
+    for line in table.lines().skip(1) {
+        let fields: Vec<&str> = line.split(',').collect();
+        assert_eq!(fields.len(), header.len());
+        assert!(names.contains(&fields[2]), "activity {}", fields[2]);
+        let probabilities: Vec<f64> = fields[3..3 + names.len()].iter().map(|p| p.parse().unwrap()).collect();
+        assert!((probabilities.iter().sum::<f64>() - 1.0).abs() < 1e-9);
+        assert!(fields[3 + names.len()..].iter().all(|v| v.parse::<f64>().unwrap().is_finite()));
+    }
+    let frames = truth.lines().count() - 1;
+    assert_eq!(summary["frames"], frames);
+    assert_eq!(summary["seed"], 3);
+    assert!(summary["likelihood_evaluations_per_frame"].as_f64().unwrap() > names.len() as f64 * 6.0);
+    let bvh = fs::read_to_string(a.join("trajectory.bvh")).unwrap();
+    assert!(bvh.contains(&format!("Frames: {frames}\n")) && bvh.contains("ROOT pelvis"));
+}
+
+#[test]
+fn a_frame_without_a_silhouette_is_coasted_and_left_without_activity() {
+    let tmp = tempfile::tempdir().unwrap();
+    let video = video(tmp.path());
+    let blank = image::GrayImage::new(160, 120);
+    blank.save(video.join("frames/000010.png")).unwrap();
+    let vocab = shipped("vocab/default.vocab");
+    let frames = video.join("frames");
+    ok(run(tmp.path(), &["track", frames.to_str().unwrap(), "--vocab", vocab.to_str().unwrap(), "-o", "run"], "2"));
+    let table = fs::read_to_string(tmp.path().join("run/frames.csv")).unwrap();
+    let row: Vec<&str> = table.lines().nth(11).unwrap().split(',').collect();
+    assert_eq!(row[0], "10");
+    assert_eq!(row[2], "", "no activity on a frame without a silhouette");
+    let primitives = summary_without_timing(&tmp.path().join("run"))["primitives"].as_array().unwrap().len();
+    assert!(row[3..3 + primitives].iter().all(|p| p.is_empty()), "no probabilities: {row:?}");
+    assert!(row[3 + primitives..].iter().all(|v| v.parse::<f64>().is_ok()), "the pose is still estimated");
+    assert_eq!(summary_without_timing(&tmp.path().join("run"))["coasted_frames"], 1);
+}
+
+/// A track that must fail: `code`, an error naming the problem, and no
+/// output folder.
+fn refused(dir: &Path, args: &[&str], code: i32, says: &str) {
+    let out = run(dir, args, "2");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
+    assert!(err.contains(says) && !err.contains("panicked"), "{args:?}: {err}");
+    assert!(!dir.join("out").exists(), "{args:?} left output");
+}
+
+#[test]
+fn bad_input_is_refused_with_nothing_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let video = video(dir);
+    let frames = video.join("frames");
+    let frames = frames.to_str().unwrap();
+    let vocab = shipped("vocab/default.vocab");
+    let vocab = vocab.to_str().unwrap();
+    refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--particles", "0"], 2, "--particles 0");
+    refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--lookahead", "0"], 2, "--lookahead 0");
+    refused(dir, &["track", frames, "--vocab", "missing.vocab", "-o", "out"], 1, "missing.vocab");
+    refused(dir, &["track", "nowhere", "--vocab", vocab, "-o", "out"], 1, "nowhere");
+    // Frames of another size than the camera's.
+    let take = shipped("mocap/punch.bvh");
+    ok(run(dir, &["render", take.to_str().unwrap(), "-o", "small", "--size", "96x72"], "2"));
+    let camera = video.join("camera.json");
+    let small = dir.join("small/frames");
+    let args = ["track", small.to_str().unwrap(), "--vocab", vocab, "-o", "out", "--camera", camera.to_str().unwrap()];
+    refused(dir, &args, 1, "the camera is 160×120");
+    // Frames with no camera beside them and none given.
+    fs::create_dir(dir.join("loose")).unwrap();
+    fs::copy(video.join("frames/000000.png"), dir.join("loose/000000.png")).unwrap();
+    refused(dir, &["track", "loose", "--vocab", vocab, "-o", "out"], 2, "no camera.json beside the frames");
+    // A frame of another kind partway.
+    let rgb = image::RgbImage::from_pixel(160, 120, image::Rgb([90, 120, 30]));
+    rgb.save(video.join("frames/000005.png")).unwrap();
+    refused(dir, &["track", frames, "--vocab", vocab, "-o", "out"], 1, "000005.png");
+}
