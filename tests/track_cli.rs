@@ -141,3 +141,20 @@ fn bad_input_is_refused_with_nothing_written() {
     rgb.save(video.join("frames/000005.png")).unwrap();
     refused(dir, &["track", frames, "--vocab", vocab, "-o", "out"], 1, "000005.png");
 }
+
+#[test]
+fn a_real_capture_is_tracked_with_the_shipped_vocabulary_within_150_mm_of_its_upper_body() {
+    let Some(real) = common::real_mocap_dir() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let take = real.join("two_hand_wave.bvh");
+    ok(run(tmp.path(), &["render", take.to_str().unwrap(), "-o", "video"], "2"));
+    let vocab = shipped("vocab/default.vocab");
+    ok(run(tmp.path(), &["track", "video/frames", "--vocab", vocab.to_str().unwrap(), "-o", "run"], "2"));
+    let estimate = imitate::report::read_track(&tmp.path().join("run/frames.csv")).unwrap();
+    let truth = imitate::report::read_track(&tmp.path().join("video/truth.csv")).unwrap();
+    let primitives = imitate::report::read_primitives(&tmp.path().join("run/summary.json")).unwrap();
+    let metrics = imitate::report::metrics::score(&estimate, &truth, &primitives, 0.5).unwrap();
+    // Measured 100 mm: the vocabulary is the synthetic demonstrator's, and
+    // waving with both hands is none of its activities.
+    assert!(metrics.upper_body_mm < 150.0, "upper body {:.1} mm", metrics.upper_body_mm);
+}
