@@ -1,5 +1,6 @@
 //! One primitive's particle filter in its latent space (eq. 4).
 
+use crate::mocap::body::JointVector;
 use crate::track::cone::{Cone, ConeScratch};
 use crate::track::root::{Root, RootSearch};
 use crate::vision::distance::Observation;
@@ -33,7 +34,7 @@ pub struct Estimate {
     /// The latent pose estimate `ȳ_i[t]` and its joint-space pose.
     pub latent: Vec<f64>,
     pub root: Root,
-    pub x: crate::mocap::body::JointVector,
+    pub x: JointVector,
     /// R of the estimate (eq. 8), or `None` on a frame with no silhouette.
     pub likelihood: Option<f64>,
     /// Attractor progress of the estimate, in [0, 1).
@@ -102,29 +103,34 @@ impl<'v> Filter<'v> {
         self.primitive.speed().median * self.params.frame_time_s
     }
 
-    fn score(&mut self, observation: &Observation, y: &[f64], root: &Root) -> f64 {
+    /// The joint-space pose of particle `j`.
+    fn particle_pose(&self, j: usize) -> JointVector {
+        let d = self.primitive.dims();
+        self.primitive.reconstruct(&self.particles[j * d..(j + 1) * d])
+    }
+
+    fn score(&mut self, observation: &Observation, x: &JointVector, root: &Root) -> f64 {
         self.evaluations += 1;
-        self.scorer.score(observation, &root.pose(&self.primitive.reconstruct(y)))
+        self.scorer.score(observation, &root.pose(x))
     }
 
     /// Chooses the heading (of `candidates`, each with its prior) and the
     /// particle that best explain the first frame, then hill-climbs the
     /// root with that particle's pose for `climb` steps.
     pub fn place(&mut self, observation: &Observation, candidates: &[(f64, f64)], climb: usize) {
-        let d = self.primitive.dims();
         let mut best = (f64::MIN, f64::MIN, self.root, 0);
         for &(heading, prior) in candidates {
             let root = Root { heading, ..self.root };
             for j in 0..self.params.particles {
-                let y = self.particles[j * d..(j + 1) * d].to_vec();
-                let s = self.score(observation, &y, &root);
+                let x = self.particle_pose(j);
+                let s = self.score(observation, &x, &root);
                 if s * prior > best.0 {
                     best = (s * prior, s, root, j);
                 }
             }
         }
         let (_, score, mut root, j) = best;
-        let x = self.primitive.reconstruct(&self.particles[j * d..(j + 1) * d]);
+        let x = self.particle_pose(j);
         let search = RootSearch { steps: climb, ..self.params.root };
         search.refine(&mut root, &x, score, observation, &mut self.scorer, &mut self.rng);
         self.evaluations += climb as u64;
@@ -147,13 +153,14 @@ impl<'v> Filter<'v> {
         let Some(observation) = observation else {
             self.weights.fill(1.0 / n as f64);
             let latent = self.mean();
-            return self.estimate(latent, None);
+            let x = self.primitive.reconstruct(&latent);
+            return self.estimate(latent, x, None);
         };
         let root = self.root;
         let mut scores = vec![0.0; n];
         for (j, s) in scores.iter_mut().enumerate() {
-            let y = self.particles[j * d..(j + 1) * d].to_vec();
-            *s = self.score(observation, &y, &root);
+            let x = self.particle_pose(j);
+            *s = self.score(observation, &x, &root);
         }
         // Weights relative to the best score, so the power cannot underflow all.
         let top = scores.iter().copied().fold(f64::MIN, f64::max);
@@ -167,23 +174,22 @@ impl<'v> Filter<'v> {
         self.weights.iter_mut().for_each(|w| *w /= total);
         let best = (0..n).fold(0, |b, j| if self.weights[j] > self.weights[b] { j } else { b });
         let mean = self.mean();
-        let mean_score = self.score(observation, &mean, &root);
-        let (latent, score) = if mean_score >= scores[best] {
-            (mean, mean_score)
+        let mean_x = self.primitive.reconstruct(&mean);
+        let mean_score = self.score(observation, &mean_x, &root);
+        let (latent, x, score) = if mean_score >= scores[best] {
+            (mean, mean_x, mean_score)
         } else {
-            (self.particles[best * d..(best + 1) * d].to_vec(), scores[best])
+            (self.particles[best * d..(best + 1) * d].to_vec(), self.particle_pose(best), scores[best])
         };
-        let x = self.primitive.reconstruct(&latent);
         let mut root = self.root;
         let score = self.params.root.refine(&mut root, &x, score, observation, &mut self.scorer, &mut self.rng);
         self.evaluations += self.params.root.steps as u64;
         self.root = root;
         self.resample();
-        self.estimate(latent, Some(score))
+        self.estimate(latent, x, Some(score))
     }
 
-    fn estimate(&self, latent: Vec<f64>, likelihood: Option<f64>) -> Estimate {
-        let x = self.primitive.reconstruct(&latent);
+    fn estimate(&self, latent: Vec<f64>, x: JointVector, likelihood: Option<f64>) -> Estimate {
         let progress = self.primitive.progress(&latent);
         Estimate { latent, root: self.root, x, likelihood, progress }
     }
