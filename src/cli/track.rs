@@ -86,7 +86,9 @@ const MANIFOLD: f64 = 2.0;
 /// Root refinement per frame.
 const ROOT_SEARCH: RootSearch = RootSearch { steps: 4, move_m: 0.03, turn_rad: 0.05 };
 /// Memory of eq. 10's feedback.
-const FEEDBACK_MEMORY_S: f64 = 0.5;
+const FEEDBACK_MEMORY_S: f64 = 0.6;
+/// Particles renewed from the training poses each frame.
+const RENEWAL: f64 = 0.05;
 
 fn params(args: &Args) -> Result<TrackParams, UsageError> {
     if args.particles == 0 {
@@ -105,6 +107,7 @@ fn params(args: &Args) -> Result<TrackParams, UsageError> {
         cone: Cone { lookahead: args.lookahead, spread: CONE_SPREAD },
         sharpness: SHARPNESS,
         manifold: MANIFOLD,
+        renewal: RENEWAL,
         root: ROOT_SEARCH,
         frame_time_s: 1.0 / args.fps,
     };

@@ -23,6 +23,12 @@ pub struct FilterParams {
     /// pose its latent span can reach (which would let every primitive
     /// explain every activity).
     pub manifold: f64,
+    /// Chance that a particle is redrawn from the primitive's training
+    /// poses instead of moving through the cone. Without it, a filter whose
+    /// activity is not being performed collapses onto the one pose of its
+    /// manifold that best fits the other activity, and is then too far away
+    /// to follow its own activity when that starts.
+    pub renewal: f64,
     pub root: RootSearch,
     /// Seconds between frames.
     pub frame_time_s: f64,
@@ -137,7 +143,8 @@ impl<'v> Filter<'v> {
         self.root = root;
     }
 
-    /// One frame: every particle moves through the bending cone; with an
+    /// One frame: every particle moves through the bending cone (or a few
+    /// are renewed from the training poses); with an
     /// observation it is weighted by its likelihood, the estimate is the
     /// better of the weighted mean and the best particle, the root is
     /// refined for it, and the particles are resampled. Without one (an
@@ -146,9 +153,15 @@ impl<'v> Filter<'v> {
     pub fn step(&mut self, observation: Option<&Observation>) -> Estimate {
         let (d, n) = (self.primitive.dims(), self.params.particles);
         let step = self.step_length();
+        let field = self.primitive.field();
         for j in 0..n {
             let y = &mut self.particles[j * d..(j + 1) * d];
-            self.params.cone.sample(self.primitive, step, y, &mut self.rng, &mut self.cone);
+            if self.rng.gen_bool(self.params.renewal) {
+                let i = self.rng.gen_range(0..field.len());
+                y.copy_from_slice(&field.points()[i * d..(i + 1) * d]);
+            } else {
+                self.params.cone.sample(self.primitive, step, y, &mut self.rng, &mut self.cone);
+            }
         }
         let Some(observation) = observation else {
             self.weights.fill(1.0 / n as f64);

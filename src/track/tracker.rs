@@ -23,14 +23,20 @@ const HEADINGS: usize = 8;
 /// Hill-climbing steps of the first placement.
 const PLACEMENT_STEPS: usize = 40;
 
-/// How the primitives' estimates become activity probabilities.
+/// How the primitives' estimates become activity probabilities. Both use
+/// the filters' own pose likelihood, `R^sharpness` (eq. 8 sharpened, see
+/// [`FilterParams::sharpness`]), so recognition weighs a pose exactly as
+/// tracking does.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 #[serde(rename_all = "snake_case", tag = "kind")]
 pub enum Recognition {
     /// Eq. 7: the estimates' likelihoods, normalized over the primitives.
     Likelihood,
-    /// Eq. 10: each likelihood times the primitive's recent probability
-    /// `w_i` (an exponential average over `memory_s` seconds), normalized.
+    /// Eq. 10: each likelihood times `w_i`, what the history says of
+    /// primitive `i` before this frame: last frame's probability, with a
+    /// chance of switching to any primitive that makes the history fade
+    /// over `memory_s` seconds (the forward pass of a hidden Markov model
+    /// over activities).
     Feedback { memory_s: f64 },
 }
 
@@ -124,9 +130,21 @@ impl<'v> Tracker<'v> {
             self.place(silhouette, observation);
         }
         let estimates: Vec<Estimate> = self.filters.par_iter_mut().map(|f| f.step(observation.as_ref())).collect();
-        let probabilities = observation.is_some().then(|| self.recognize(&estimates));
+        let probabilities = match observation {
+            Some(_) => Some(self.recognize(&estimates)),
+            None => {
+                self.forget();
+                None
+            }
+        };
         if let Some(p) = &probabilities {
             self.winner = (0..p.len()).fold(0, |best, i| if p[i] > p[best] { i } else { best });
+            // One person, one root: every filter goes on from the winner's,
+            // which its own search then refines. A filter left with its own
+            // root while another activity is performed moves that root to
+            // fit its wrong pose, and stays lost when its activity starts.
+            let root = estimates[self.winner].root;
+            self.filters.iter_mut().for_each(|f| f.set_root(root));
         }
         let chosen = &estimates[self.winner];
         let pose = chosen.root.pose(&chosen.x);
@@ -155,23 +173,127 @@ impl<'v> Tracker<'v> {
         self.placed = true;
     }
 
-    /// Eq. 7, or eq. 10 with the primitives' recent probabilities.
+    /// Eq. 7, or eq. 10 with the primitives' history.
     fn recognize(&mut self, estimates: &[Estimate]) -> Vec<f64> {
         let likelihood = |e: &Estimate| e.likelihood.expect("an observed frame scores every estimate");
-        let mut p: Vec<f64> = match self.params.recognition {
-            Recognition::Likelihood => estimates.iter().map(likelihood).collect(),
-            Recognition::Feedback { .. } => {
-                estimates.iter().zip(&self.history).map(|(e, w)| likelihood(e) * w).collect()
-            }
-        };
+        // Relative to the best, so the power cannot underflow all.
+        let top = estimates.iter().map(likelihood).fold(f64::MIN, f64::max);
+        let mut p: Vec<f64> =
+            estimates.iter().map(|e| (likelihood(e) / top).powf(self.params.filter.sharpness)).collect();
+        if let Recognition::Feedback { .. } = self.params.recognition {
+            self.forget();
+            p.iter_mut().zip(&self.history).for_each(|(p, w)| *p *= w);
+        }
         let total: f64 = p.iter().sum();
         p.iter_mut().for_each(|v| *v /= total);
-        if let Recognition::Feedback { memory_s } = self.params.recognition {
-            let keep = (-self.params.filter.frame_time_s / memory_s).exp();
-            for (w, &now) in self.history.iter_mut().zip(&p) {
-                *w = keep * *w + (1.0 - keep) * now;
-            }
-        }
+        self.history.copy_from_slice(&p);
         p
+    }
+
+    /// Eq. 10's prior for the next frame: any activity may start, so each
+    /// keeps `1 − ε` of its probability and shares `ε` evenly; `ε` makes
+    /// the history fade over `memory_s`.
+    fn forget(&mut self) {
+        if let Recognition::Feedback { memory_s } = self.params.recognition {
+            let switch = 1.0 - (-self.params.filter.frame_time_s / memory_s).exp();
+            let even = switch / self.history.len() as f64;
+            self.history.iter_mut().for_each(|w| *w = (1.0 - switch) * *w + even);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::track::cone::Cone;
+    use crate::track::root::RootSearch;
+    use crate::vision::camera::Preset;
+    use std::path::Path;
+
+    fn vocabulary() -> Vocabulary {
+        Vocabulary::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("vocab/default.vocab")).unwrap()
+    }
+
+    fn tracker(vocabulary: &Vocabulary, recognition: Recognition) -> Tracker<'_> {
+        let filter = FilterParams {
+            particles: 2,
+            cone: Cone { lookahead: 1, spread: 0.5 },
+            sharpness: 4.0,
+            manifold: 2.0,
+            renewal: 0.0,
+            root: RootSearch { steps: 0, move_m: 0.0, turn_rad: 0.0 },
+            frame_time_s: 0.1,
+        };
+        let camera = Camera::preset(Preset::Front, 40, 30).unwrap();
+        Tracker::new(vocabulary, camera, TrackParams { filter, recognition, seed: 1 }).unwrap()
+    }
+
+    /// Estimates whose likelihoods are `r` times a common factor.
+    fn estimates(tracker: &Tracker, r: &[f64]) -> Vec<Estimate> {
+        let n = tracker.filters.len();
+        (0..n)
+            .map(|i| Estimate {
+                latent: Vec::new(),
+                root: Root { position: DVec3::ZERO, heading: 0.0 },
+                x: [0.0; crate::mocap::body::DOF],
+                likelihood: Some(0.01 * r.get(i).copied().unwrap_or(1.0)),
+                progress: 0.0,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn eq7_normalizes_the_sharpened_likelihoods() {
+        let vocabulary = vocabulary();
+        let mut t = tracker(&vocabulary, Recognition::Likelihood);
+        let n = t.filters.len();
+        let p = t.recognize(&estimates(&t, &[2.0]));
+        // (2^4, 1, 1, …) normalized.
+        let total = 16.0 + (n - 1) as f64;
+        assert!((p[0] - 16.0 / total).abs() < 1e-12, "{p:?}");
+        assert!(p[1..].iter().all(|v| (v - 1.0 / total).abs() < 1e-12), "{p:?}");
+    }
+
+    #[test]
+    fn eq10_keeps_the_activity_through_one_contrary_frame_that_eq7_follows() {
+        let vocabulary = vocabulary();
+        let memory = Recognition::Feedback { memory_s: 0.6 };
+        let (mut eq7, mut eq10) = (tracker(&vocabulary, Recognition::Likelihood), tracker(&vocabulary, memory));
+        for t in [&mut eq7, &mut eq10] {
+            for _ in 0..10 {
+                let e = estimates(t, &[1.3]);
+                t.recognize(&e);
+            }
+            let e = estimates(t, &[1.0, 1.3]);
+            let p = t.recognize(&e);
+            let winner = (0..p.len()).fold(0, |b, i| if p[i] > p[b] { i } else { b });
+            let expected = if matches!(t.params.recognition, Recognition::Likelihood) { 1 } else { 0 };
+            assert_eq!(winner, expected, "{:?}: {p:?}", t.params.recognition);
+        }
+        // After enough contrary frames, eq. 10 switches too.
+        let switched = (0..20).any(|_| {
+            let e = estimates(&eq10, &[1.0, 1.3]);
+            let p = eq10.recognize(&e);
+            p[1] > p[0]
+        });
+        assert!(switched);
+    }
+
+    #[test]
+    fn eq10_history_fades_towards_even_over_coasted_frames() {
+        let vocabulary = vocabulary();
+        let mut t = tracker(&vocabulary, Recognition::Feedback { memory_s: 0.6 });
+        let n = t.filters.len() as f64;
+        let e = estimates(&t, &[3.0]);
+        t.recognize(&e);
+        let before = t.history[0];
+        t.forget();
+        // One frame of 0.1 s keeps exp(−0.1/0.6) of the history and shares the rest evenly.
+        let keep = (-0.1f64 / 0.6).exp();
+        assert!((t.history[0] - (keep * before + (1.0 - keep) / n)).abs() < 1e-12);
+        for _ in 0..200 {
+            t.forget();
+        }
+        assert!(t.history.iter().all(|w| (w - 1.0 / n).abs() < 1e-9), "{:?}", t.history);
     }
 }
