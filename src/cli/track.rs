@@ -5,9 +5,12 @@ use super::render::{camera, refuse_nonempty};
 use super::{Global, Outcome, UsageError, note, progress};
 use anyhow::{Context, bail};
 use imitate::fsutil::{write_atomic, write_dir_atomic};
+use imitate::mocap::body::Body;
 use imitate::mocap::body::Joint;
 use imitate::mocap::bvh::write_bvh;
 use imitate::mocap::pose::Motion;
+use imitate::mocap::pose::Pose;
+use imitate::track::baseline::{AnnealParams, FullSpaceFilter, mean_training_pose};
 use imitate::track::cone::Cone;
 use imitate::track::filter::FilterParams;
 use imitate::track::root::RootSearch;
@@ -70,9 +73,54 @@ pub struct Args {
     /// median of the frames.
     #[arg(long, value_name = "IMAGE")]
     pub background: Option<PathBuf>,
+    /// Run a baseline instead of the primitives' filters. `full-space`:
+    /// one annealed particle filter over every joint angle and the root
+    /// (Deutscher, Blake & Reid 2000), spending as many likelihood
+    /// evaluations per frame as the primitives' filters would; its rows
+    /// name no activity.
+    #[arg(long, value_enum)]
+    pub baseline: Option<Baseline>,
     /// Replace the output folder if it exists.
     #[arg(long)]
     pub force: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, clap::ValueEnum)]
+pub enum Baseline {
+    FullSpace,
+}
+
+/// What follows the person: the primitives' filters, or the baseline.
+enum Follower<'v> {
+    Primitives(Box<Tracker<'v>>),
+    FullSpace(Box<FullSpaceFilter>),
+}
+
+impl Follower<'_> {
+    /// The frame's pose, and the primitives' view of it when they track.
+    fn step(&mut self, mask: &Mask) -> (Pose, Option<FrameEstimate>) {
+        match self {
+            Follower::Primitives(tracker) => {
+                let estimate = tracker.step(mask);
+                (estimate.pose, Some(estimate))
+            }
+            Follower::FullSpace(filter) => (filter.step(mask), None),
+        }
+    }
+
+    fn evaluations(&self) -> u64 {
+        match self {
+            Follower::Primitives(tracker) => tracker.evaluations(),
+            Follower::FullSpace(filter) => filter.evaluations(),
+        }
+    }
+
+    fn body(&self) -> &Body {
+        match self {
+            Follower::Primitives(tracker) => tracker.body(),
+            Follower::FullSpace(filter) => filter.body(),
+        }
+    }
 }
 
 /// Bending-cone noise across the axis, in steps of one frame's typical
@@ -147,23 +195,34 @@ fn header(names: &[&str]) -> String {
     columns.iter().map(|c| truth::quoted(c)).collect::<Vec<_>>().join(",") + "\n"
 }
 
-/// One frame's row of `frames.csv`.
-fn row(frame: usize, time_s: f64, names: &[&str], estimate: &FrameEstimate, tracker: &Tracker) -> String {
+/// One frame's row of `frames.csv`: `pose`, and the primitives' view of
+/// it when they tracked (the baseline leaves those columns empty).
+fn row(
+    frame: usize,
+    time_s: f64,
+    names: &[&str],
+    pose: &Pose,
+    estimate: Option<&FrameEstimate>,
+    body: &Body,
+) -> String {
     let mut line = format!("{frame},{time_s},");
-    if estimate.probabilities.is_some() {
-        line.push_str(&truth::quoted(names[estimate.winner]));
+    let probabilities = estimate.and_then(|e| e.probabilities.as_ref());
+    if let (Some(e), Some(_)) = (estimate, probabilities) {
+        line.push_str(&truth::quoted(names[e.winner]));
     }
     for i in 0..names.len() {
         line.push(',');
-        if let Some(p) = &estimate.probabilities {
+        if let Some(p) = probabilities {
             write!(line, "{}", p[i]).expect("writing to a string cannot fail");
         }
     }
-    for e in &estimate.estimates {
-        write!(line, ",{}", e.progress).expect("writing to a string cannot fail");
+    for i in 0..names.len() {
+        line.push(',');
+        if let Some(e) = estimate {
+            write!(line, "{}", e.estimates[i].progress).expect("writing to a string cannot fail");
+        }
     }
-    let pose = &estimate.pose;
-    let world = tracker.body().forward(pose);
+    let world = body.forward(pose);
     let numbers = [pose.root.x, pose.root.y, pose.root.z, pose.heading]
         .into_iter()
         .chain(Joint::ALL.iter().flat_map(|&j| world.position(j).to_array()));
@@ -182,8 +241,16 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let camera = choose_camera(&args, &source)?;
     let mut extractor = Extractor::new(ExtractParams::default()).expect("the default settings are valid");
     let mut background_used = None;
-    let mut tracker =
+    let tracker =
         Tracker::new(&vocabulary, camera.clone(), params).with_context(|| args.vocab.display().to_string())?;
+    let anneal = AnnealParams::with_budget(vocabulary.primitives().len() * (args.particles + 1 + ROOT_SEARCH.steps));
+    let mut follower = match args.baseline {
+        None => Follower::Primitives(Box::new(tracker)),
+        Some(Baseline::FullSpace) => {
+            let start = mean_training_pose(&vocabulary);
+            Follower::FullSpace(Box::new(FullSpaceFilter::new(camera.clone(), anneal, start, args.seed)))
+        }
+    };
     let names: Vec<&str> = vocabulary.primitives().iter().map(|p| p.name()).collect();
     let bar = progress(global, source.frame_count().unwrap_or(0) as u64, "track");
     let started = Instant::now();
@@ -201,10 +268,10 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             background_used = Some(from);
         }
         extractor.extract_into(&frame, &mut mask)?;
-        let estimate = tracker.step(&mask);
-        coasted += usize::from(estimate.probabilities.is_none());
-        rows.push(row(k, k as f64 / args.fps, &names, &estimate, &tracker));
-        poses.push(estimate.pose);
+        let (pose, estimate) = follower.step(&mask);
+        coasted += usize::from(mask.count() == 0);
+        rows.push(row(k, k as f64 / args.fps, &names, &pose, estimate.as_ref(), follower.body()));
+        poses.push(pose);
         bar.inc(1);
         k += 1;
     }
@@ -213,8 +280,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         bail!("{}: no frames", args.input.display());
     }
     let seconds = started.elapsed().as_secs_f64();
-    let evaluations = tracker.evaluations();
-    let motion = Motion { body: tracker.body().clone(), frame_time_s: 1.0 / args.fps, poses };
+    let evaluations = follower.evaluations();
+    let motion = Motion { body: follower.body().clone(), frame_time_s: 1.0 / args.fps, poses };
     let summary = serde_json::json!({
         "input": args.input.display().to_string(),
         "vocabulary": {
@@ -227,6 +294,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         "camera": camera.spec(),
         "background": background_used,
         "settings": params,
+        "baseline": args.baseline.map(|_| serde_json::json!({ "kind": "full_space", "settings": anneal })),
         "seed": args.seed,
         "fps": args.fps,
         "frames": k,
@@ -251,13 +319,17 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         },
         io,
     )?;
+    let who = match args.baseline {
+        None => format!("{} primitives × {} particles", names.len(), args.particles),
+        Some(Baseline::FullSpace) => {
+            format!("full-space annealed filter, {} layers × {} particles", anneal.layers, anneal.particles)
+        }
+    };
     note(
         global,
         &format!(
-            "{}: {k} frames ({coasted} without a silhouette), {} primitives × {} particles → {output} in {seconds:.2} s ({:.1} frames/s, {:.0} likelihoods/frame)",
+            "{}: {k} frames ({coasted} without a silhouette), {who} → {output} in {seconds:.2} s ({:.1} frames/s, {:.0} likelihoods/frame)",
             args.input.display(),
-            names.len(),
-            args.particles,
             k as f64 / seconds,
             evaluations as f64 / k as f64
         ),

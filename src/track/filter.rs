@@ -217,22 +217,30 @@ impl<'v> Filter<'v> {
         mean
     }
 
-    /// Systematic resampling: one uniform draw, `n` evenly spaced pointers
-    /// into the weights' running sum; low variance, and `O(n)`.
     fn resample(&mut self) {
-        let (d, n) = (self.primitive.dims(), self.params.particles);
-        let start: f64 = self.rng.gen_range(0.0..1.0 / n as f64);
-        let mut next = Vec::with_capacity(n * d);
-        let (mut j, mut cumulative) = (0, self.weights[0]);
-        for k in 0..n {
-            let pointer = start + k as f64 / n as f64;
-            while pointer > cumulative && j + 1 < n {
-                j += 1;
-                cumulative += self.weights[j];
-            }
+        let d = self.primitive.dims();
+        let mut next = Vec::with_capacity(self.particles.len());
+        for j in systematic(&self.weights, &mut self.rng) {
             next.extend_from_slice(&self.particles[j * d..(j + 1) * d]);
         }
         self.particles = next;
-        self.weights.fill(1.0 / n as f64);
+        self.weights.fill(1.0 / self.params.particles as f64);
     }
+}
+
+/// Systematic resampling: the indices `n` evenly spaced pointers, after one
+/// uniform draw, pick from the running sum of `weights` (normalized, `n`
+/// of them); low variance, and `O(n)`.
+pub fn systematic<'w>(weights: &'w [f64], rng: &mut impl Rng) -> impl Iterator<Item = usize> + 'w {
+    let n = weights.len();
+    let start: f64 = rng.gen_range(0.0..1.0 / n as f64);
+    let (mut j, mut cumulative) = (0, weights[0]);
+    (0..n).map(move |k| {
+        let pointer = start + k as f64 / n as f64;
+        while pointer > cumulative && j + 1 < n {
+            j += 1;
+            cumulative += weights[j];
+        }
+        j
+    })
 }
