@@ -32,35 +32,41 @@ pub struct RootSearch {
 }
 
 impl Root {
-    /// Where a standing person's pelvis is, from their silhouette: the ray
-    /// through the silhouette's centre column at its lowest row meets the
-    /// floor (y = 0) at the feet, and the pelvis stands `pelvis_height`
-    /// above them. Where that ray misses the floor (a camera looking up),
-    /// the person is put at the distance of the camera's `look_at`.
-    /// `None` for an empty silhouette.
+    /// Where a standing person's pelvis is, from their silhouette. Seen
+    /// from the side (a camera looking less than 45° down), the ray through
+    /// the silhouette's centre column at its lowest row meets the floor
+    /// (y = 0) at the feet, and the pelvis stands `pelvis_height` above
+    /// them; where that ray misses the floor (a camera looking up), the
+    /// person is put at the distance of the camera's `look_at`. Seen from
+    /// above, the lowest row is no longer the feet, and the ray through the
+    /// silhouette's centre of mass meets the pelvis's height near the
+    /// pelvis. `None` for an empty silhouette.
     pub fn from_silhouette(camera: &Camera, mask: &Mask, pelvis_height: f64, heading: f64) -> Option<Root> {
-        let (mut count, mut sum_x, mut bottom) = (0usize, 0usize, 0usize);
+        let (mut count, mut sum_x, mut sum_y, mut bottom) = (0usize, 0usize, 0usize, 0usize);
         for (y, row) in mask.pixels().chunks_exact(mask.width()).enumerate() {
             let n = row.iter().filter(|&&p| p != 0).count();
             if n > 0 {
                 count += n;
                 sum_x += row.iter().enumerate().filter(|(_, p)| **p != 0).map(|(x, _)| x).sum::<usize>();
+                sum_y += n * y;
                 bottom = y;
             }
         }
         if count == 0 {
             return None;
         }
-        let u = sum_x as f64 / count as f64 + 0.5;
+        let (u, v) = (sum_x as f64 / count as f64 + 0.5, sum_y as f64 / count as f64 + 0.5);
         let origin = camera.position();
-        let ray = camera.ray(u, bottom as f64 + 1.0);
-        let feet = if ray.y < -1e-6 {
-            origin + ray * (-origin.y / ray.y)
+        let look_at = DVec3::from_array(camera.spec().look_at);
+        let forward = (look_at - origin).normalize();
+        let meet = |ray: DVec3, height: f64| (ray.y < -1e-6).then(|| origin + ray * ((height - origin.y) / ray.y));
+        let ground = if forward.y < -std::f64::consts::FRAC_1_SQRT_2 {
+            meet(camera.ray(u, v), pelvis_height)
         } else {
-            let look_at = DVec3::from_array(camera.spec().look_at);
-            origin + ray * (look_at - origin).length()
+            meet(camera.ray(u, bottom as f64 + 1.0), 0.0)
         };
-        Some(Root { position: DVec3::new(feet.x, pelvis_height, feet.z), heading })
+        let at = ground.unwrap_or_else(|| origin + camera.ray(u, bottom as f64 + 1.0) * (look_at - origin).length());
+        Some(Root { position: DVec3::new(at.x, pelvis_height, at.z), heading })
     }
 
     /// The pose with this root and joint-space vector `x`.
@@ -94,5 +100,33 @@ impl RootSearch {
             }
         }
         score
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mocap::body::Body;
+    use crate::vision::camera::Preset;
+
+    #[test]
+    fn the_root_is_placed_under_the_person_from_the_front_side_and_overhead() {
+        let body = Body::standard();
+        let mut pose = Pose::rest(&body);
+        pose.root = DVec3::new(0.2, body.pelvis_height(), -0.3);
+        for preset in [Preset::Front, Preset::Side, Preset::Overhead] {
+            let camera = Camera::preset(preset, 160, 120).unwrap();
+            let mut scorer = Scorer::new(camera.clone(), body.clone());
+            let mask = scorer.draw(&pose).clone();
+            let root = Root::from_silhouette(&camera, &mask, body.pelvis_height(), 0.0).unwrap();
+            let off = (root.position - pose.root).with_y(0.0).length();
+            eprintln!("{preset:?}: placed {off:.3} m from the pelvis");
+            // Level cameras see the nearest toe in the lowest row, and at 4 m a
+            // row is 8 cm of floor; the hill climb refines it.
+            assert!(off < 0.25, "{preset:?}: placed {off:.2} m away");
+            assert_eq!(root.position.y, body.pelvis_height());
+        }
+        let empty = Mask::new(160, 120);
+        assert!(Root::from_silhouette(&Camera::preset(Preset::Front, 160, 120).unwrap(), &empty, 1.0, 0.0).is_none());
     }
 }

@@ -154,6 +154,13 @@ impl Vocabulary {
         &self.primitives
     }
 
+    /// Keeps only the primitives `keep` accepts (tracking with part of a
+    /// vocabulary); the result matches no file, so it has no checksum.
+    pub fn retain(&mut self, keep: impl FnMut(&Primitive) -> bool) {
+        self.primitives.retain(keep);
+        self.checksum = None;
+    }
+
     pub fn build_info(&self) -> &BuildInfo {
         &self.build
     }
