@@ -9,9 +9,7 @@
 //!     cargo bench --bench track
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use imitate::track::cone::Cone;
 use imitate::track::filter::FilterParams;
-use imitate::track::root::RootSearch;
 use imitate::track::tracker::{Recognition, TrackParams, Tracker};
 use imitate::vision::camera::{Camera, Preset};
 use imitate::vision::mask::Mask;
@@ -40,17 +38,9 @@ fn track(c: &mut Criterion) {
     let frames = silhouettes(&camera);
     let mut group = c.benchmark_group("track_frame");
     for particles in [6, 50, 200] {
-        // The settings `imitate track` uses, with eq. 10.
-        let filter = FilterParams {
-            particles,
-            cone: Cone { lookahead: 5, spread: 0.5 },
-            sharpness: 8.0,
-            manifold: 2.0,
-            renewal: 0.05,
-            root: RootSearch { steps: 4, move_m: 0.03, turn_rad: 0.05 },
-            frame_time_s: 1.0 / 15.0,
-        };
-        let params = TrackParams { filter, recognition: Recognition::Feedback { memory_s: 0.6 }, seed: 1 };
+        // The settings `imitate track --feedback` uses.
+        let filter = FilterParams::standard(particles, 5, 1.0 / 15.0);
+        let params = TrackParams { filter, recognition: Recognition::FEEDBACK, seed: 1 };
         let mut tracker = Tracker::new(&vocabulary, camera.clone(), params).expect("valid settings");
         let mut k = 0;
         group.bench_function(BenchmarkId::new("4_primitives", particles), |b| {

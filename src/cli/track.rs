@@ -11,9 +11,7 @@ use imitate::mocap::bvh::write_bvh;
 use imitate::mocap::pose::Motion;
 use imitate::mocap::pose::Pose;
 use imitate::track::baseline::{AnnealParams, FullSpaceFilter, mean_training_pose};
-use imitate::track::cone::Cone;
 use imitate::track::filter::FilterParams;
-use imitate::track::root::RootSearch;
 use imitate::track::tracker::{FrameEstimate, Recognition, TrackParams, Tracker};
 use imitate::vision::camera::Camera;
 use imitate::vision::frames::{Expect, FrameKind, FrameSource, read_image};
@@ -123,21 +121,6 @@ impl Follower<'_> {
     }
 }
 
-/// Bending-cone noise across the axis, in steps of one frame's typical
-/// latent displacement.
-const CONE_SPREAD: f64 = 0.5;
-/// Particle weights are R to this power.
-const SHARPNESS: f64 = 8.0;
-/// Width of the manifold prior, in steps of one frame's typical latent
-/// displacement.
-const MANIFOLD: f64 = 2.0;
-/// Root refinement per frame.
-const ROOT_SEARCH: RootSearch = RootSearch { steps: 4, move_m: 0.03, turn_rad: 0.05 };
-/// Memory of eq. 10's feedback.
-const FEEDBACK_MEMORY_S: f64 = 0.6;
-/// Particles renewed from the training poses each frame.
-const RENEWAL: f64 = 0.05;
-
 fn params(args: &Args) -> Result<TrackParams, UsageError> {
     if args.particles == 0 {
         return Err(UsageError("--particles 0: a filter needs at least 1 particle".into()));
@@ -148,17 +131,8 @@ fn params(args: &Args) -> Result<TrackParams, UsageError> {
     if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 1000.0) {
         return Err(UsageError(format!("--fps {}: must be above 0 and at most 1000", args.fps)));
     }
-    let recognition =
-        if args.feedback { Recognition::Feedback { memory_s: FEEDBACK_MEMORY_S } } else { Recognition::Likelihood };
-    let filter = FilterParams {
-        particles: args.particles,
-        cone: Cone { lookahead: args.lookahead, spread: CONE_SPREAD },
-        sharpness: SHARPNESS,
-        manifold: MANIFOLD,
-        renewal: RENEWAL,
-        root: ROOT_SEARCH,
-        frame_time_s: 1.0 / args.fps,
-    };
+    let recognition = if args.feedback { Recognition::FEEDBACK } else { Recognition::Likelihood };
+    let filter = FilterParams::standard(args.particles, args.lookahead, 1.0 / args.fps);
     Ok(TrackParams { filter, recognition, seed: args.seed })
 }
 
@@ -243,7 +217,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let mut background_used = None;
     let tracker =
         Tracker::new(&vocabulary, camera.clone(), params).with_context(|| args.vocab.display().to_string())?;
-    let anneal = AnnealParams::with_budget(vocabulary.primitives().len() * (args.particles + 1 + ROOT_SEARCH.steps));
+    let anneal = AnnealParams::with_budget(vocabulary.primitives().len() * params.filter.evaluations_per_frame());
     let mut follower = match args.baseline {
         None => Follower::Primitives(Box::new(tracker)),
         Some(Baseline::FullSpace) => {

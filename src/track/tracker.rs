@@ -40,6 +40,11 @@ pub enum Recognition {
     Feedback { memory_s: f64 },
 }
 
+impl Recognition {
+    /// Eq. 10 as `imitate track --feedback` runs it.
+    pub const FEEDBACK: Recognition = Recognition::Feedback { memory_s: 0.6 };
+}
+
 /// Everything the tracker is set up with.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct TrackParams {
