@@ -84,6 +84,8 @@ pub struct FullSpaceFilter {
     camera: Camera,
     body: Body,
     particles: Vec<Pose>,
+    /// One per worker thread.
+    scorers: Vec<Scorer>,
     estimate: Pose,
     rng: ChaCha8Rng,
     /// Likelihood evaluations made so far.
@@ -96,11 +98,13 @@ impl FullSpaceFilter {
         let body = Body::standard();
         let look_at = DVec3::from_array(camera.spec().look_at);
         let estimate = Pose { root: DVec3::new(look_at.x, body.pelvis_height(), look_at.z), heading: 0.0, x: start };
+        let scorers = (0..rayon::current_num_threads()).map(|_| Scorer::new(camera.clone(), body.clone())).collect();
         FullSpaceFilter {
             params,
             camera,
             body,
             particles: Vec::new(),
+            scorers,
             estimate,
             rng: ChaCha8Rng::seed_from_u64(seed),
             evaluations: 0,
@@ -161,15 +165,20 @@ impl FullSpaceFilter {
         }
     }
 
-    /// The particles' likelihoods, scored in parallel (one scorer per
-    /// worker); the draws stay serial, so threads cannot change results.
+    /// The particles' likelihoods, scored in parallel: one contiguous share
+    /// of the particles per kept scorer, since a scorer's drawing buffers
+    /// cost more to build than a score. The draws stay serial, so threads
+    /// cannot change results.
     fn score(&mut self, observation: &Observation) -> Vec<f64> {
         self.evaluations += self.particles.len() as u64;
-        let (camera, body) = (&self.camera, &self.body);
-        self.particles
-            .par_iter()
-            .map_init(|| Scorer::new(camera.clone(), body.clone()), |scorer, pose| scorer.score(observation, pose))
-            .collect()
+        let share = self.particles.len().div_ceil(self.scorers.len());
+        let mut scores = vec![0.0; self.particles.len()];
+        scores.par_chunks_mut(share).zip(self.particles.par_chunks(share)).zip(self.scorers.par_iter_mut()).for_each(
+            |((out, poses), scorer)| {
+                out.iter_mut().zip(poses).for_each(|(s, pose)| *s = scorer.score(observation, pose));
+            },
+        );
+        scores
     }
 
     /// Normalized weights `(R/top)^β`, with `β` found by bisection so that
