@@ -5,7 +5,7 @@
 # table per trial. Real captures are used when ../shared/mocap/real (or
 # $IMITATE_REAL_MOCAP) exists.
 #
-#   bash scripts/track-trials.sh [WORK_DIR]        # about 6 minutes on 2 cores
+#   bash scripts/track-trials.sh [WORK_DIR]        # about 2.5 minutes on 2 cores
 #
 # Every number is the mean over seeds 1–5 (min–max after it).
 set -euo pipefail
