@@ -5,7 +5,7 @@
 # table per trial. Real captures are used when ../shared/mocap/real (or
 # $IMITATE_REAL_MOCAP) exists.
 #
-#   bash scripts/track-trials.sh [WORK_DIR]        # about 2.5 minutes on 2 cores
+#   bash scripts/track-trials.sh [WORK_DIR]        # about 2.5 minutes on 2 cores; WORK_DIR may be reused
 #
 # Every number is the mean over seeds 1–5 (min–max after it).
 set -euo pipefail
@@ -60,7 +60,7 @@ header() {
 # Held-out sequences: seed 5, 3 repetitions of each activity.
 render() { # NAME SPEED CAMERA
   "$imitate" -q synth -o "seq_$1" --sequence circles,wave-h,wave-v --reps 3 --seed 5 --speed "$2"
-  "$imitate" -q render "seq_$1/sequence.bvh" -o "video_$1" --labels "seq_$1/labels.csv" --camera "$3"
+  "$imitate" -q render "seq_$1/sequence.bvh" -o "video_$1" --labels "seq_$1/labels.csv" --camera "$3" --force
 }
 render front 1 front
 for speed in 0.25 2 4; do render "speed$speed" "$speed" front; done
@@ -104,7 +104,7 @@ if [ -d "$real" ]; then
   # face the camera).
   python3 -c 'import json; c = json.load(open("video_front/camera.json")); c["position"][2] *= -1; json.dump(c, open("behind.json", "w"))'
   for take in wave_hello boxing; do
-    "$imitate" -q render "$real/$take.bvh" -o "video_$take" --labels "$real/labels.csv"
+    "$imitate" -q render "$real/$take.bvh" -o "video_$take" --labels "$real/labels.csv" --force
     if python3 -c 'import csv,math,sys; r=next(csv.DictReader(open(sys.argv[1]))); sys.exit(math.cos(float(r["root_heading"])) >= 0)' "video_$take/truth.csv"; then
       echo "$take faces away from the camera: the camera is put behind it" >&2
       "$imitate" -q render "$real/$take.bvh" -o "video_$take" --labels "$real/labels.csv" --camera behind.json --force
