@@ -48,7 +48,7 @@ fn a_video_tracks_to_a_trajectory_frames_table_and_summary_the_same_on_one_or_fo
         ok(run(tmp.path(), &args, threads));
     }
     let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
-    for file in ["trajectory.bvh", "frames.csv"] {
+    for file in ["trajectory.bvh", "frames.csv", "likelihoods.csv"] {
         assert_eq!(fs::read(a.join(file)).unwrap(), fs::read(b.join(file)).unwrap(), "{file}");
     }
     assert_eq!(summary_without_timing(&a), summary_without_timing(&b));
@@ -74,6 +74,16 @@ fn a_video_tracks_to_a_trajectory_frames_table_and_summary_the_same_on_one_or_fo
         let probabilities: Vec<f64> = fields[3..3 + names.len()].iter().map(|p| p.parse().unwrap()).collect();
         assert!((probabilities.iter().sum::<f64>() - 1.0).abs() < 1e-9);
         assert!(fields[3 + names.len()..].iter().all(|v| v.parse::<f64>().unwrap().is_finite()));
+    }
+    // likelihoods.csv: each primitive's R, one row per frame, all positive.
+    let likelihoods = fs::read_to_string(a.join("likelihoods.csv")).unwrap();
+    let header: Vec<String> = likelihoods.lines().next().unwrap().split(',').map(String::from).collect();
+    let expected: Vec<String> =
+        std::iter::once("frame".to_string()).chain(names.iter().map(|n| format!("likelihood_{n}"))).collect();
+    assert_eq!(header, expected);
+    assert_eq!(likelihoods.lines().count(), truth.lines().count());
+    for line in likelihoods.lines().skip(1) {
+        assert!(line.split(',').skip(1).all(|v| v.parse::<f64>().unwrap() > 0.0), "{line}");
     }
     let frames = truth.lines().count() - 1;
     assert_eq!(summary["frames"], frames);

@@ -10,6 +10,7 @@ mod fit;
 mod inspect;
 mod learn;
 mod render;
+mod report;
 mod retarget;
 mod score;
 mod segment;
@@ -17,9 +18,12 @@ mod synth;
 mod track;
 mod vocab;
 
+use anyhow::bail;
 use clap::{Parser, Subcommand};
+use imitate::vision::camera::{Camera, Preset};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
+use std::path::Path;
 use std::process::ExitCode;
 
 /// Learn dynamical motion primitives from motion capture and follow a
@@ -55,6 +59,7 @@ enum Command {
     Render(render::Args),
     Track(track::Args),
     Score(score::Args),
+    Report(report::Args),
 }
 
 /// How a command ended, when it did not fail outright.
@@ -84,6 +89,7 @@ pub fn main() -> ExitCode {
         Command::Render(args) => render::run(args, cli.global),
         Command::Track(args) => track::run(args, cli.global),
         Command::Score(args) => score::run(args, cli.global),
+        Command::Report(args) => report::run(args, cli.global),
     };
     match result {
         Ok(Outcome::Success) => ExitCode::SUCCESS,
@@ -152,4 +158,25 @@ pub fn note(global: Global, text: &str) {
     if !global.quiet {
         eprintln!("{text}");
     }
+}
+
+/// `--camera`: a preset framed at `width × height`, or a camera.json file
+/// (which gives its own size).
+pub fn camera(choice: &str, width: u32, height: u32) -> anyhow::Result<Camera> {
+    match Preset::from_name(choice) {
+        Some(preset) => Camera::preset(preset, width, height).map_err(|e| UsageError(format!("--size: {e}")).into()),
+        None if Path::new(choice).is_file() => Ok(Camera::read(Path::new(choice))?),
+        None => Err(UsageError(format!(
+            "--camera {choice}: neither a preset (front, side, overhead) nor a camera.json file"
+        ))
+        .into()),
+    }
+}
+
+/// Refuses an output folder that holds something, unless `force`.
+pub fn refuse_nonempty(output: &Path, force: bool) -> anyhow::Result<()> {
+    if !force && output.read_dir().is_ok_and(|mut d| d.next().is_some()) {
+        bail!("{}: exists and is not empty; choose another folder or pass --force to replace it", output.display());
+    }
+    Ok(())
 }

@@ -2,13 +2,12 @@
 
 use super::retarget::RetargetArgs;
 use super::segment::load_corpus;
-use super::{Global, Outcome, UsageError, note, progress};
+use super::{Global, Outcome, UsageError, camera, note, progress, refuse_nonempty};
 use anyhow::{Context, bail};
 use image::ImageEncoder;
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use imitate::fsutil::{write_atomic, write_dir_atomic};
 use imitate::mocap::pose::Motion;
-use imitate::vision::camera::{Camera, Preset};
 use imitate::vision::color::Scene;
 use imitate::vision::mask::Mask;
 use imitate::vision::noise::{Level, Noise};
@@ -17,7 +16,7 @@ use imitate::vision::shape::capsules;
 use imitate::vision::truth;
 use rayon::prelude::*;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Render a BVH take (any skeleton: it is retargeted first) as binary
@@ -75,27 +74,6 @@ fn parse_size(text: &str) -> Result<(u32, u32), UsageError> {
     let bad = || UsageError(format!("--size {text}: expected WIDTHxHEIGHT, e.g. 160x120"));
     let (w, h) = text.split_once(['x', 'X']).ok_or_else(bad)?;
     Ok((w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?))
-}
-
-/// `--camera`: a preset framed at `width × height`, or a camera.json file
-/// (which gives its own size).
-pub fn camera(choice: &str, width: u32, height: u32) -> anyhow::Result<Camera> {
-    match Preset::from_name(choice) {
-        Some(preset) => Camera::preset(preset, width, height).map_err(|e| UsageError(format!("--size: {e}")).into()),
-        None if Path::new(choice).is_file() => Ok(Camera::read(Path::new(choice))?),
-        None => Err(UsageError(format!(
-            "--camera {choice}: neither a preset (front, side, overhead) nor a camera.json file"
-        ))
-        .into()),
-    }
-}
-
-/// Refuses an output folder that holds something, unless `force`.
-pub fn refuse_nonempty(output: &Path, force: bool) -> anyhow::Result<()> {
-    if !force && output.read_dir().is_ok_and(|mut d| d.next().is_some()) {
-        bail!("{}: exists and is not empty; choose another folder or pass --force to replace it", output.display());
-    }
-    Ok(())
 }
 
 /// The take and, when labelled, each of its frames' activity.

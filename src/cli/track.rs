@@ -1,8 +1,7 @@
 //! `imitate track`: the virtual trajectory, the activity and every
 //! primitive's probability and progress, from frames and a vocabulary.
 
-use super::render::{camera, refuse_nonempty};
-use super::{Global, Outcome, UsageError, note, progress};
+use super::{Global, Outcome, UsageError, camera, note, progress, refuse_nonempty};
 use anyhow::{Context, bail};
 use imitate::fsutil::{write_atomic, write_dir_atomic};
 use imitate::mocap::body::Body;
@@ -14,14 +13,14 @@ use imitate::track::baseline::{AnnealParams, FullSpaceFilter, mean_training_pose
 use imitate::track::filter::FilterParams;
 use imitate::track::tracker::{FrameEstimate, Recognition, TrackParams, Tracker};
 use imitate::vision::camera::Camera;
-use imitate::vision::frames::{Expect, FrameKind, FrameSource, read_image};
+use imitate::vision::frames::{Expect, FrameSource, beside_frames};
 use imitate::vision::mask::Mask;
-use imitate::vision::silhouette::{ExtractParams, Extractor, estimate_background};
+use imitate::vision::silhouette::Silhouettes;
 use imitate::vision::truth;
 use imitate::vocab::vocabulary::Vocabulary;
 use std::fmt::Write as _;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Track a person through one camera with a vocabulary of primitives: one
@@ -29,8 +28,8 @@ use std::time::Instant;
 /// model), activity recognition from the estimates' likelihoods, and the
 /// virtual trajectory (the winning primitive's pose each frame).
 ///
-/// Writes DIR/trajectory.bvh, DIR/frames.csv and DIR/summary.json (see the
-/// README).
+/// Writes DIR/trajectory.bvh, DIR/frames.csv, DIR/likelihoods.csv (not
+/// with --baseline) and DIR/summary.json (see the README).
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The frames: a folder of PNG or JPEG images (silhouettes or color),
@@ -136,15 +135,8 @@ fn params(args: &Args) -> Result<TrackParams, UsageError> {
     Ok(TrackParams { filter, recognition, seed: args.seed })
 }
 
-/// A file `render` writes beside its frames: in INPUT (a folder) or next
-/// to it.
-fn beside(input: &Path, name: &str) -> Option<PathBuf> {
-    let parent = input.parent().map(|p| p.join(name));
-    [input.is_dir().then(|| input.join(name)), parent].into_iter().flatten().find(|p| p.is_file())
-}
-
 fn choose_camera(args: &Args, source: &FrameSource) -> anyhow::Result<Camera> {
-    let camera = match (&args.camera, beside(&args.input, "camera.json")) {
+    let camera = match (&args.camera, beside_frames(&args.input, "camera.json")) {
         (Some(choice), _) => camera(choice, source.width() as u32, source.height() as u32)?,
         (None, Some(path)) => Camera::read(&path)?,
         (None, None) => {
@@ -167,6 +159,26 @@ fn header(names: &[&str]) -> String {
     columns.extend(["root_x", "root_y", "root_z", "root_heading"].map(String::from));
     columns.extend(truth::position_columns());
     columns.iter().map(|c| truth::quoted(c)).collect::<Vec<_>>().join(",") + "\n"
+}
+
+/// The header of `likelihoods.csv`.
+fn likelihood_header(names: &[&str]) -> String {
+    let columns = std::iter::once("frame".to_string()).chain(names.iter().map(|n| format!("likelihood_{n}")));
+    columns.map(|c| truth::quoted(&c)).collect::<Vec<_>>().join(",") + "\n"
+}
+
+/// One frame's row of `likelihoods.csv`: each primitive's estimate's R
+/// (eq. 8), empty on a frame without a silhouette.
+fn likelihood_row(frame: usize, estimate: &FrameEstimate) -> String {
+    let mut line = frame.to_string();
+    for e in &estimate.estimates {
+        line.push(',');
+        if let Some(r) = e.likelihood {
+            write!(line, "{r}").expect("writing to a string cannot fail");
+        }
+    }
+    line.push('\n');
+    line
 }
 
 /// One frame's row of `frames.csv`: `pose`, and the primitives' view of
@@ -211,10 +223,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let params = params(&args)?;
     refuse_nonempty(&args.output, args.force)?;
     let vocabulary = Vocabulary::load(&args.vocab)?;
-    let mut source = FrameSource::open(&args.input, Expect::Auto)?;
+    let source = FrameSource::open(&args.input, Expect::Auto)?;
     let camera = choose_camera(&args, &source)?;
-    let mut extractor = Extractor::new(ExtractParams::default()).expect("the default settings are valid");
-    let mut background_used = None;
     let tracker =
         Tracker::new(&vocabulary, camera.clone(), params).with_context(|| args.vocab.display().to_string())?;
     let anneal = AnnealParams::with_budget(vocabulary.primitives().len() * params.filter.evaluations_per_frame());
@@ -229,22 +239,17 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let bar = progress(global, source.frame_count().unwrap_or(0) as u64, "track");
     let started = Instant::now();
     let mut mask = Mask::new(camera.width(), camera.height());
-    let (mut rows, mut poses, mut coasted) = (Vec::new(), Vec::new(), 0usize);
+    let (mut rows, mut likelihood_rows, mut poses, mut coasted) = (Vec::new(), Vec::new(), Vec::new(), 0usize);
     let mut k = 0;
-    while let Some(frame) = source.next_frame() {
-        let frame = frame?;
-        if frame.kind() == FrameKind::Color && background_used.is_none() {
-            let (background, from) = match args.background.clone().or_else(|| beside(&args.input, "background.png")) {
-                Some(path) => (read_image(&path)?, path.display().to_string()),
-                None => (estimate_background(&source)?, "the per-pixel median of the frames".to_string()),
-            };
-            extractor.set_background(&background);
-            background_used = Some(from);
-        }
-        extractor.extract_into(&frame, &mut mask)?;
+    let mut silhouettes = Silhouettes::new(&args.input, source, args.background.clone());
+    while let Some(silhouette) = silhouettes.next_into(&mut mask) {
+        silhouette?;
         let (pose, estimate) = follower.step(&mask);
         coasted += usize::from(mask.count() == 0);
         rows.push(row(k, k as f64 / args.fps, &names, &pose, estimate.as_ref(), follower.body()));
+        if let Some(e) = &estimate {
+            likelihood_rows.push(likelihood_row(k, e));
+        }
         poses.push(pose);
         bar.inc(1);
         k += 1;
@@ -266,7 +271,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             "name": p.name(), "label": p.majority_label(), "dims": p.dims(),
         })).collect::<Vec<_>>(),
         "camera": camera.spec(),
-        "background": background_used,
+        "background": silhouettes.background_used(),
         "settings": params,
         "baseline": args.baseline.map(|_| serde_json::json!({ "kind": "full_space", "settings": anneal })),
         "seed": args.seed,
@@ -288,6 +293,13 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
                 rows.iter().try_for_each(|r| w.write_all(r.as_bytes()))
             })
             .map_err(io)?;
+            if !likelihood_rows.is_empty() {
+                write_atomic(&dir.join("likelihoods.csv"), |w| {
+                    w.write_all(likelihood_header(&names).as_bytes())?;
+                    likelihood_rows.iter().try_for_each(|r| w.write_all(r.as_bytes()))
+                })
+                .map_err(io)?;
+            }
             let json = serde_json::to_string_pretty(&summary).expect("the summary serializes") + "\n";
             std::fs::write(dir.join("summary.json"), json).map_err(io)
         },

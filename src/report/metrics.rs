@@ -163,7 +163,8 @@ impl<'a> Guess<'a> {
     }
 }
 
-const UPPER_BODY: [Joint; 10] = [
+/// The joints of the upper-body error.
+pub const UPPER_BODY: [Joint; 10] = [
     Joint::Spine,
     Joint::Chest,
     Joint::Neck,

@@ -2,7 +2,13 @@
 //! run's `frames.csv` and `summary.json` and a render's `truth.csv` (here),
 //! and the scores themselves ([`metrics`]).
 
+pub mod figures;
+pub mod filmstrip;
+pub mod html;
 pub mod metrics;
+pub mod page;
+pub mod plot;
+pub mod run;
 
 use crate::mocap::body::{JOINTS, Joint};
 use crate::vision::truth::position_columns;
@@ -49,6 +55,56 @@ pub fn read_primitives(path: &Path) -> Result<Primitives, ReportError> {
 
 fn read(path: &Path) -> Result<String, ReportError> {
     std::fs::read_to_string(path).map_err(|source| ReportError::Read { file: path.display().to_string(), source })
+}
+
+/// Named columns of values over frames, `None` where a frame has none (a
+/// coasted frame, a baseline run).
+pub type Curves = Vec<(String, Vec<Option<f64>>)>;
+
+/// A CSV table read whole: its header and records (with their lines).
+pub struct Table {
+    pub file: String,
+    pub header: Vec<String>,
+    records: Vec<Record>,
+}
+
+impl Table {
+    pub fn read(path: &Path) -> Result<Table, ReportError> {
+        let file = path.display().to_string();
+        let text = read(path)?;
+        let (header, records) = parse_csv(&file, &text)?;
+        Ok(Table { file, header, records })
+    }
+
+    pub fn rows(&self) -> usize {
+        self.records.len()
+    }
+
+    /// The columns whose names start with `prefix`, as (the rest of the
+    /// name, its values): a number, or `None` for an empty field.
+    pub fn prefixed(&self, prefix: &str) -> Result<Curves, ReportError> {
+        let columns = self.header.iter().enumerate().filter_map(|(i, c)| Some((i, c.strip_prefix(prefix)?)));
+        columns.map(|(i, name)| Ok((name.to_string(), self.optional_numbers(i)?))).collect()
+    }
+
+    fn optional_numbers(&self, col: usize) -> Result<Vec<Option<f64>>, ReportError> {
+        self.records
+            .iter()
+            .map(|(line, fields)| {
+                let text = fields[col].trim();
+                if text.is_empty() {
+                    return Ok(None);
+                }
+                text.parse::<f64>().ok().filter(|v| v.is_finite()).map(Some).ok_or_else(|| ReportError::BadValue {
+                    file: self.file.clone(),
+                    line: *line,
+                    column: self.header[col].clone(),
+                    expected: "a number or nothing",
+                    text: fields[col].clone(),
+                })
+            })
+            .collect()
+    }
 }
 
 fn parse_track(file: String, text: &str) -> Result<Track, ReportError> {

@@ -82,7 +82,7 @@ pub enum FrameError {
     MixedKinds { frame: String, kind: FrameKind, first: String, first_kind: FrameKind },
     #[error(
         "{path}: decoding video needs `{program}`, which is not on PATH; install it with \
-         `bash scripts/install-ffmpeg.sh` (Debian's ffmpeg package)"
+         `bash scripts/install-tools.sh ffmpeg` (Debian's ffmpeg package)"
     )]
     FfmpegMissing { path: String, program: String },
     #[error("{path}: cannot run ffmpeg: {source}")]
@@ -238,6 +238,13 @@ fn is_image_name(path: &Path) -> bool {
     path.extension()
         .and_then(OsStr::to_str)
         .is_some_and(|e| ["png", "jpg", "jpeg"].iter().any(|x| e.eq_ignore_ascii_case(x)))
+}
+
+/// A file `render` writes beside its frames (`camera.json`,
+/// `background.png`): in `input` when it is a folder, else next to it.
+pub fn beside_frames(input: &Path, name: &str) -> Option<PathBuf> {
+    let parent = input.parent().map(|p| p.join(name));
+    [input.is_dir().then(|| input.join(name)), parent].into_iter().flatten().find(|p| p.is_file())
 }
 
 /// The program that decodes videos.
@@ -953,8 +960,12 @@ mod tests {
         assert!(!ends_with_jpeg_eoi(&[0xD9]));
     }
 
+    /// Whether ffmpeg runs. Under CI it must: `bash scripts/test.sh`
+    /// installs it.
     fn ffmpeg_on_path() -> bool {
-        Command::new(FFMPEG).arg("-version").output().is_ok_and(|o| o.status.success())
+        let found = Command::new(FFMPEG).arg("-version").output().is_ok_and(|o| o.status.success());
+        assert!(found || std::env::var_os("CI").is_none(), "ffmpeg is not on PATH: under CI it is required");
+        found
     }
 
     #[test]
@@ -966,7 +977,7 @@ mod tests {
         let message = error.to_string();
         assert!(matches!(error, FrameError::FfmpegMissing { .. }), "{message}");
         assert!(message.starts_with(&video.display().to_string()), "{message}");
-        assert!(message.contains("install it with `bash scripts/install-ffmpeg.sh` (Debian's ffmpeg package)"));
+        assert!(message.contains("install it with `bash scripts/install-tools.sh ffmpeg` (Debian's ffmpeg package)"));
         if !ffmpeg_on_path() {
             let error = FrameSource::open(&video, Expect::Auto).unwrap_err();
             assert!(matches!(error, FrameError::FfmpegMissing { .. }), "{error}");

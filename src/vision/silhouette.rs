@@ -9,8 +9,9 @@
 //! found over runs of pixels rather than pixel by pixel. An [`Extractor`]
 //! keeps its scratch buffers, so after the first frame it allocates nothing.
 
-use crate::vision::frames::{Frame, FrameError, FrameKind, FrameSource};
+use crate::vision::frames::{Frame, FrameError, FrameKind, FrameSource, beside_frames, read_image};
 use crate::vision::mask::Mask;
+use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// How many frames, at most, the per-pixel median background is taken over.
@@ -369,6 +370,61 @@ pub fn median_background(frames: &[Frame]) -> Result<Frame, SilhouetteError> {
 /// [`FrameSource::sample`]).
 pub fn estimate_background(source: &FrameSource) -> Result<Frame, SilhouetteError> {
     median_background(&source.sample(MEDIAN_SAMPLE)?)
+}
+
+/// The silhouettes of a source's frames, in order, as `track` and `report`
+/// see them. Color frames are compared with the background chosen when
+/// the first one arrives: the one given, else `background.png` beside the
+/// frames (as `render --color` writes it), else the per-pixel median of the
+/// frames.
+pub struct Silhouettes {
+    source: FrameSource,
+    extractor: Extractor,
+    /// Where the frames came from, to find `background.png` beside them.
+    input: PathBuf,
+    background: Option<PathBuf>,
+    background_used: Option<String>,
+}
+
+impl Silhouettes {
+    /// Silhouettes of `source`, opened from `input`, with the default
+    /// extraction settings.
+    pub fn new(input: &Path, source: FrameSource, background: Option<PathBuf>) -> Silhouettes {
+        let extractor = Extractor::new(ExtractParams::default()).expect("the default settings are valid");
+        Silhouettes { source, extractor, input: input.to_path_buf(), background, background_used: None }
+    }
+
+    pub fn source(&self) -> &FrameSource {
+        &self.source
+    }
+
+    /// The background color frames were compared with, once one was.
+    pub fn background_used(&self) -> Option<&str> {
+        self.background_used.as_deref()
+    }
+
+    /// The next frame's silhouette, written into `mask`; `None` after the
+    /// last frame.
+    pub fn next_into(&mut self, mask: &mut Mask) -> Option<Result<(), SilhouetteError>> {
+        let frame = match self.source.next_frame()? {
+            Ok(frame) => frame,
+            Err(e) => return Some(Err(e.into())),
+        };
+        Some(self.extract(&frame, mask))
+    }
+
+    fn extract(&mut self, frame: &Frame, mask: &mut Mask) -> Result<(), SilhouetteError> {
+        if frame.kind() == FrameKind::Color && self.background_used.is_none() {
+            let (background, from) =
+                match self.background.clone().or_else(|| beside_frames(&self.input, "background.png")) {
+                    Some(path) => (read_image(&path)?, path.display().to_string()),
+                    None => (estimate_background(&self.source)?, "the per-pixel median of the frames".to_string()),
+                };
+            self.extractor.set_background(&background);
+            self.background_used = Some(from);
+        }
+        self.extractor.extract_into(frame, mask)
+    }
 }
 
 /// Scratch rows of the binary median filter.

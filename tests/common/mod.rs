@@ -33,6 +33,22 @@ pub fn real_bvh_files() -> Vec<PathBuf> {
     files
 }
 
+/// Debian's headless browser, for the report tests. Absent outside CI, the
+/// caller skips (and says so); under CI its absence fails the test, since
+/// `bash scripts/test.sh` installs it.
+pub fn chromium() -> Option<PathBuf> {
+    let found = std::env::var_os("PATH")
+        .into_iter()
+        .flat_map(|paths| std::env::split_paths(&paths).collect::<Vec<_>>())
+        .map(|dir| dir.join("chromium"))
+        .find(|p| p.is_file());
+    if found.is_none() {
+        assert!(std::env::var_os("CI").is_none(), "chromium is not on PATH: under CI it is required");
+        eprintln!("skipping the browser check: chromium is not on PATH (bash scripts/install-tools.sh chromium)");
+    }
+    found
+}
+
 /// The `imitate` binary built for these tests.
 pub fn imitate() -> Command {
     Command::new(env!("CARGO_BIN_EXE_imitate"))

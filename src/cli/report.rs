@@ -1,0 +1,103 @@
+//! `imitate report`: one tracking run as a self-contained HTML page.
+
+use super::{Global, Outcome, UsageError, note, refuse_nonempty};
+use anyhow::{Context, bail};
+use imitate::fsutil::write_dir_atomic;
+use imitate::report::filmstrip::{MAX_FRAMES, pick_frames};
+use imitate::report::metrics::score;
+use imitate::report::page::{Truth, run_report};
+use imitate::report::read_track;
+use imitate::report::run::Run;
+use imitate::vision::camera::Camera;
+use imitate::vision::frames::{Expect, FrameSource};
+use imitate::vision::mask::Mask;
+use imitate::vision::silhouette::Silhouettes;
+use std::path::{Path, PathBuf};
+
+/// Turn one `imitate track` run into a report: Figure 8 (attractor
+/// progress and activity probabilities per primitive), a filmstrip of the
+/// silhouettes with the estimate drawn over them and seen from above, and,
+/// with --truth, the error over time, the scores and the confusion matrix.
+///
+/// Writes DIR/index.html (self-contained: opens from disk, no network),
+/// the plots as PNG and SVG, filmstrip.png, and with --truth metrics.json.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The tracking run's folder (frames.csv, likelihoods.csv, summary.json).
+    #[arg(value_name = "RUN_DIR")]
+    pub run: PathBuf,
+    /// The video's ground truth, as `imitate render` writes it.
+    #[arg(long, value_name = "truth.csv")]
+    pub truth: Option<PathBuf>,
+    /// The frames that were tracked [default: the input named in
+    /// summary.json].
+    #[arg(long, value_name = "FRAMES")]
+    pub frames: Option<PathBuf>,
+    /// Where to write the report [default: RUN_DIR/report].
+    #[arg(short, long, value_name = "DIR")]
+    pub output: Option<PathBuf>,
+    /// Seconds after each switch of the true activity that the settled
+    /// accuracy leaves out.
+    #[arg(long, default_value_t = 0.5, value_name = "S")]
+    pub settle: f64,
+    /// Replace the output folder if it exists.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// The silhouettes of frames `picks` of `input`, which must hold `frames`
+/// frames.
+fn silhouettes(input: &Path, frames: usize, picks: &[usize]) -> anyhow::Result<Vec<Mask>> {
+    let source = FrameSource::open(input, Expect::Auto)?;
+    if let Some(n) = source.frame_count().filter(|&n| n != frames) {
+        bail!(
+            "{}: {n} frames, but the run tracked {frames}; pass the frames it tracked with --frames",
+            input.display()
+        );
+    }
+    let mut silhouettes = Silhouettes::new(input, source, None);
+    let (mut mask, mut out, mut k) = (Mask::new(1, 1), Vec::new(), 0);
+    while out.len() < picks.len() {
+        match silhouettes.next_into(&mut mask) {
+            Some(r) => r?,
+            None => bail!("{}: ends after {k} frames, but the run tracked {frames}", input.display()),
+        }
+        if picks[out.len()] == k {
+            out.push(mask.clone());
+        }
+        k += 1;
+    }
+    Ok(out)
+}
+
+pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
+    if !(args.settle.is_finite() && args.settle >= 0.0) {
+        return Err(UsageError(format!("--settle {}: must be a number of seconds, 0 or more", args.settle)).into());
+    }
+    let output = args.output.clone().unwrap_or_else(|| args.run.join("report"));
+    refuse_nonempty(&output, args.force)?;
+    let run = Run::read(&args.run)?;
+    let summary = args.run.join("summary.json");
+    let camera = Camera::new(run.summary.camera.clone(), &summary.display().to_string())
+        .with_context(|| format!("{}: the camera", summary.display()))?;
+    let truth = args.truth.as_deref().map(read_track).transpose()?;
+    let metrics = truth.as_ref().map(|t| score(&run.track, t, &run.primitives, args.settle)).transpose()?;
+    let input = args.frames.clone().unwrap_or_else(|| PathBuf::from(&run.summary.input));
+    let picks = pick_frames(run.track.frame.len(), MAX_FRAMES);
+    let observed = silhouettes(&input, run.track.frame.len(), &picks)?;
+    let truth_view = truth.as_ref().zip(metrics.as_ref()).map(|(track, metrics)| Truth { track, metrics });
+    let mut files = run_report(&run, truth_view, &camera, &picks, &observed);
+    if let Some(m) = &metrics {
+        let json = serde_json::to_string_pretty(m).expect("metrics are plain numbers and maps") + "\n";
+        files.push(("metrics.json".into(), json.into_bytes()));
+    }
+    let shown = output.display().to_string();
+    let io = |e: std::io::Error| anyhow::anyhow!("{shown}: cannot write: {e}");
+    write_dir_atomic(
+        &output,
+        |dir| files.iter().try_for_each(|(name, bytes)| std::fs::write(dir.join(name), bytes)).map_err(io),
+        io,
+    )?;
+    note(global, &format!("{}: report → {}", args.run.display(), output.join("index.html").display()));
+    Ok(Outcome::Success)
+}

@@ -1,0 +1,116 @@
+//! The report of one tracking run (`imitate report`): what was tracked and
+//! how, Figure 8, the error over time and the scores when the truth is
+//! known, and a filmstrip.
+
+use super::figures;
+use super::filmstrip::filmstrip;
+use super::html::Page;
+use super::metrics::{Metrics, Track};
+use super::run::Run;
+use crate::vision::camera::Camera;
+use crate::vision::mask::Mask;
+
+/// A file of a report: its name in the report's folder and its bytes.
+pub type File = (String, Vec<u8>);
+
+/// What the truth adds to a run's report.
+pub struct Truth<'a> {
+    pub track: &'a Track,
+    pub metrics: &'a Metrics,
+}
+
+/// The headline numbers of a scored run: value, caption, `metrics.json` key.
+pub fn headline(metrics: &Metrics) -> Vec<(String, String, String)> {
+    let mut numbers = vec![(
+        format!("{:.1} mm", metrics.upper_body_mm),
+        "upper-body error, root-relative".to_string(),
+        "upper_body_mm".to_string(),
+    )];
+    if let Some(a) = metrics.recognition.recognition_accuracy_settled {
+        numbers.push((
+            format!("{:.1}%", 100.0 * a),
+            format!("activity recognized (outside {} s of a switch)", metrics.recognition.settle_s),
+            "recognition_accuracy_settled".to_string(),
+        ));
+    }
+    numbers.push((format!("{:.1} mm", metrics.hand_mm), "hand error".into(), "hand_mm".into()));
+    numbers
+}
+
+/// The scores of a run as table rows: measure, value.
+pub fn score_rows(m: &Metrics) -> Vec<Vec<String>> {
+    let r = &m.recognition;
+    let percent = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{:.1}%", 100.0 * v));
+    [
+        ("frames", m.frames.to_string()),
+        ("upper body, root-relative (mm)", format!("{:.1}", m.upper_body_mm)),
+        ("all joints, root-relative (mm)", format!("{:.1}", m.all_joints_mm)),
+        ("hands (mm)", format!("{:.1}", m.hand_mm)),
+        ("root (mm)", format!("{:.1}", m.root_mm)),
+        ("limb direction (°)", format!("{:.1}", m.limb_direction_deg)),
+        ("recognition, all scored frames", percent(r.recognition_accuracy)),
+        ("recognition, settled", percent(r.recognition_accuracy_settled)),
+        ("switches recognized", format!("{} of {}", r.switches_recognized, r.switches)),
+        ("switch latency (s)", r.switch_latency_s.map_or("–".into(), |s| format!("{s:.2}"))),
+    ]
+    .into_iter()
+    .map(|(k, v)| vec![k.to_string(), v])
+    .collect()
+}
+
+/// The report of `run`: `index.html` and its pictures (PNG and SVG),
+/// with `observed[k]` the silhouette of frame `picks[k]`.
+pub fn run_report(run: &Run, truth: Option<Truth>, camera: &Camera, picks: &[usize], observed: &[Mask]) -> Vec<File> {
+    let mut files: Vec<File> = Vec::new();
+    let mut page = Page::new(&format!("Tracking report: {}", run.dir.display()));
+    let s = &run.summary;
+    page.note(&format!(
+        "{} frames of {} at {} fps, seed {}; tracked at {:.1} frames/s with {:.0} likelihood evaluations a frame.",
+        s.frames, s.input, s.fps, s.seed, s.timing.frames_per_second, s.likelihood_evaluations_per_frame
+    ));
+    if let Some(t) = &truth {
+        page.numbers(&headline(t.metrics));
+    }
+    let sharpness = s.settings.pointer("/filter/sharpness").and_then(|v| v.as_f64()).unwrap_or(1.0);
+    if run.likelihoods.is_some() {
+        page.heading("Recognition (Figure 8)");
+        let figure = figures::recognition(run, truth.as_ref().map(|t| t.track), sharpness);
+        let (png, svg) = (figure.png(), figure.svg());
+        page.image(
+            &png,
+            "image/png",
+            "attractor progress and activity probability per primitive",
+            "Top panels: each primitive's attractor progress, the marker as wide as the primitive's relative pose \
+             likelihood that frame. Bottom: the activity probabilities. Shading: the true activity.",
+        );
+        files.push(("recognition.png".into(), png));
+        files.push(("recognition.svg".into(), svg.into_bytes()));
+    } else {
+        page.note("A baseline run: no primitives, so no recognition.");
+    }
+    if let Some(t) = &truth {
+        page.heading("Pose error");
+        let figure = figures::error_over_time(run, t.track);
+        let (png, svg) = (figure.png(), figure.svg());
+        page.image(&png, "image/png", "upper-body error over time", "Root-relative upper-body error of each frame.");
+        files.push(("error.png".into(), png));
+        files.push(("error.svg".into(), svg.into_bytes()));
+        page.table(&["measure".into(), "value".into()], &score_rows(t.metrics));
+        page.heading("Confusion");
+        page.note("Frames of each true activity (rows) by the activity named (columns), through each primitive's majority label.");
+        page.confusion(&t.metrics.recognition.confusion);
+    }
+    if !picks.is_empty() {
+        page.heading("Filmstrip");
+        let strip = filmstrip(camera, &run.track, truth.as_ref().map(|t| t.track), picks, observed);
+        page.image(&strip, "image/png", "filmstrip",
+            "Top: the observed silhouette (gray) with the estimate (blue) and the truth (orange, when known) drawn from \
+             the camera. Bottom: the same seen from above, the camera's side down.");
+        files.push(("filmstrip.png".into(), strip));
+    }
+    page.heading("Settings");
+    let settings = serde_json::to_string_pretty(&s.settings).expect("settings are JSON");
+    page.code(&settings);
+    files.push(("index.html".into(), page.finish().into_bytes()));
+    files
+}

@@ -1,0 +1,79 @@
+//! One `imitate track` run read back whole, for reports: the trajectory's
+//! joint positions, each primitive's probability, progress and likelihood
+//! per frame, and the settings from `summary.json`.
+
+use super::metrics::{Primitives, ReportError, Track};
+use super::{Curves, Table, read_primitives, read_track};
+use crate::vision::camera::CameraSpec;
+use std::path::{Path, PathBuf};
+
+/// What `summary.json` says that reports show.
+#[derive(Clone, Debug, serde::Deserialize)]
+pub struct RunSummary {
+    /// The frames tracked, as given to `track`.
+    pub input: String,
+    pub camera: CameraSpec,
+    pub fps: f64,
+    pub frames: usize,
+    pub seed: u64,
+    pub likelihood_evaluations_per_frame: f64,
+    pub timing: Timing,
+    /// The tracker's settings, as written.
+    pub settings: serde_json::Value,
+    #[serde(default)]
+    pub baseline: Option<serde_json::Value>,
+}
+
+#[derive(Clone, Debug, serde::Deserialize)]
+pub struct Timing {
+    pub seconds: f64,
+    pub frames_per_second: f64,
+}
+
+pub struct Run {
+    pub dir: PathBuf,
+    pub track: Track,
+    pub primitives: Primitives,
+    /// Each primitive's probability (eq. 7 or 10), in `frames.csv` order.
+    pub probabilities: Curves,
+    pub progress: Curves,
+    /// Each primitive's estimate's R (eq. 8), from `likelihoods.csv`;
+    /// `None` for a baseline run, which writes none.
+    pub likelihoods: Option<Curves>,
+    pub summary: RunSummary,
+}
+
+impl Run {
+    /// Reads `frames.csv`, `summary.json` and (when the primitives
+    /// tracked) `likelihoods.csv` from `dir`. Every error names the file.
+    pub fn read(dir: &Path) -> Result<Run, ReportError> {
+        let frames = dir.join("frames.csv");
+        let track = read_track(&frames)?;
+        let table = Table::read(&frames)?;
+        let summary_path = dir.join("summary.json");
+        let primitives = read_primitives(&summary_path)?;
+        let summary: RunSummary = serde_json::from_str(&super::read(&summary_path)?)
+            .map_err(|e| ReportError::Summary { file: summary_path.display().to_string(), message: e.to_string() })?;
+        let probabilities = table.prefixed("prob_")?;
+        let progress = table.prefixed("progress_")?;
+        let likelihoods = match summary.baseline {
+            Some(_) => None,
+            None => {
+                let table = Table::read(&dir.join("likelihoods.csv"))?;
+                if table.rows() != track.frame.len() {
+                    return Err(ReportError::Summary {
+                        file: table.file.clone(),
+                        message: format!("{} rows, but frames.csv has {}", table.rows(), track.frame.len()),
+                    });
+                }
+                Some(table.prefixed("likelihood_")?)
+            }
+        };
+        Ok(Run { dir: dir.to_path_buf(), track, primitives, probabilities, progress, likelihoods, summary })
+    }
+
+    /// The primitives' names, in `frames.csv` order.
+    pub fn names(&self) -> Vec<&str> {
+        self.probabilities.iter().map(|(n, _)| n.as_str()).collect()
+    }
+}

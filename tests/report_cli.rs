@@ -1,0 +1,181 @@
+//! `imitate report`: one tracking run as a self-contained page. The files
+//! it writes, the page's numbers equal to metrics.json's, the same bytes
+//! each time, the page opening in headless Chromium with every image
+//! loaded (a screenshot is kept), and bad input refused with nothing
+//! written.
+
+mod common;
+
+use common::{chromium, imitate};
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn shipped(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
+}
+
+fn run(dir: &Path, args: &[&str]) -> Output {
+    imitate().current_dir(dir).args(args).arg("-q").output().unwrap()
+}
+
+fn ok(out: Output) -> Output {
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    out
+}
+
+/// The shipped horizontal waving rendered into `dir/video` and tracked
+/// into `dir/run` (and by the full-space baseline into `dir/baseline`).
+fn tracked(dir: &Path) {
+    let (take, labels) = (shipped("mocap/wave-h.bvh"), shipped("mocap/labels.csv"));
+    ok(run(dir, &["render", take.to_str().unwrap(), "-o", "video", "--labels", labels.to_str().unwrap()]));
+    let vocab = shipped("vocab/default.vocab");
+    let track = ["track", "video/frames", "--vocab", vocab.to_str().unwrap(), "--seed", "1", "--feedback", "-o"];
+    ok(run(dir, &[&track[..], &["run"]].concat()));
+    ok(run(dir, &[&track[..], &["baseline", "--baseline", "full-space"]].concat()));
+}
+
+/// Every `data-metric="KEY">VALUE<` of a page.
+fn page_metrics(html: &str) -> Vec<(String, String)> {
+    html.split("data-metric=\"")
+        .skip(1)
+        .map(|rest| {
+            let (key, rest) = rest.split_once('"').unwrap();
+            let value = rest[1..].split_once('<').unwrap().0;
+            (key.to_string(), value.to_string())
+        })
+        .collect()
+}
+
+#[test]
+fn a_run_becomes_a_self_contained_page_whose_numbers_are_those_of_metrics_json() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    tracked(dir);
+    ok(run(dir, &["report", "run", "--truth", "video/truth.csv"]));
+    let report = dir.join("run/report");
+    for file in
+        ["index.html", "recognition.png", "recognition.svg", "error.png", "error.svg", "filmstrip.png", "metrics.json"]
+    {
+        assert!(report.join(file).is_file(), "{file} missing");
+    }
+    // The scores are `imitate score`'s, byte for byte.
+    ok(run(dir, &["score", "run", "--truth", "video/truth.csv", "-o", "score.json"]));
+    assert_eq!(fs::read(report.join("metrics.json")).unwrap(), fs::read(dir.join("score.json")).unwrap());
+    let metrics: serde_json::Value = serde_json::from_slice(&fs::read(report.join("metrics.json")).unwrap()).unwrap();
+
+    let html = fs::read_to_string(report.join("index.html")).unwrap();
+    let shown = page_metrics(&html);
+    let keys: Vec<&str> = shown.iter().map(|(k, _)| k.as_str()).collect();
+    assert_eq!(keys, ["upper_body_mm", "recognition_accuracy_settled", "hand_mm"]);
+    for (key, value) in &shown {
+        let expected = metrics[key].as_f64().unwrap();
+        let expected = match value.strip_suffix('%') {
+            Some(_) => format!("{:.1}%", 100.0 * expected),
+            None => format!("{expected:.1} mm"),
+        };
+        assert_eq!(*value, expected, "{key}");
+    }
+    // Self-contained: every image inline, nothing fetched.
+    let images = html.matches("<img ").count();
+    assert_eq!(images, 3, "Figure 8, the error over time and the filmstrip");
+    assert_eq!(html.matches("<img src=\"data:image/png;base64,").count(), images);
+    assert!(!html.contains("http://") && !html.contains("https://"));
+    for name in ["recognition.png", "error.png", "filmstrip.png"] {
+        let image = image::open(report.join(name)).unwrap();
+        assert!(image.width() >= 600 && image.height() >= 200, "{name}: {}×{}", image.width(), image.height());
+    }
+    let svg = fs::read_to_string(report.join("recognition.svg")).unwrap();
+    for primitive in ["wave-h", "activity probability"] {
+        assert!(svg.contains(primitive), "{primitive} missing from recognition.svg");
+    }
+
+    // The same run gives the same report, byte for byte.
+    ok(run(dir, &["report", "run", "--truth", "video/truth.csv", "-o", "again"]));
+    for file in ["index.html", "recognition.svg", "filmstrip.png", "error.png"] {
+        assert_eq!(fs::read(report.join(file)).unwrap(), fs::read(dir.join("again").join(file)).unwrap(), "{file}");
+    }
+
+    // A baseline run has no primitives' curves: the page says so and still
+    // shows the error and the filmstrip.
+    ok(run(dir, &["report", "baseline", "--truth", "video/truth.csv"]));
+    let html = fs::read_to_string(dir.join("baseline/report/index.html")).unwrap();
+    assert!(html.contains("A baseline run: no primitives, so no recognition."));
+    assert!(!dir.join("baseline/report/recognition.png").exists());
+    assert!(dir.join("baseline/report/filmstrip.png").is_file());
+
+    browser_check(&report.join("index.html"));
+}
+
+/// Opens the page in headless Chromium: every image must load, the console
+/// must stay silent, and a screenshot is kept in the test's target folder.
+fn browser_check(page: &Path) {
+    let Some(chromium) = chromium() else { return };
+    let url = format!("file://{}", page.display());
+    let browser = |extra: &[&str]| {
+        let out = Command::new(&chromium)
+            .args(["--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars", "--virtual-time-budget=5000"])
+            .args(["--enable-logging=stderr", "--v=0"])
+            .args(extra)
+            .arg(&url)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "chromium failed: {}", String::from_utf8_lossy(&out.stderr));
+        out
+    };
+    let out = browser(&["--dump-dom"]);
+    let dom = String::from_utf8_lossy(&out.stdout);
+    assert!(dom.contains("<body data-images-ok=\"true\">"), "not every image loaded: {}", &dom[..dom.len().min(400)]);
+    let log = String::from_utf8_lossy(&out.stderr);
+    let console: Vec<&str> = log.lines().filter(|l| l.contains("CONSOLE")).collect();
+    assert!(console.is_empty(), "the page wrote to the console: {console:?}");
+
+    let shot = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-screenshot.png");
+    let _ = fs::remove_file(&shot);
+    browser(&[&format!("--screenshot={}", shot.display()), "--window-size=1100,1400"]);
+    let image = image::open(&shot).unwrap().to_rgb8();
+    assert_eq!(image.dimensions(), (1100, 1400));
+    // Figure 8 is drawn: its colored markers and shading fill part of the view.
+    let colored = image.pixels().filter(|p| p.0.iter().max().unwrap() - p.0.iter().min().unwrap() > 60).count();
+    assert!(colored > 5000, "{colored} colored pixels in {}", shot.display());
+    eprintln!("screenshot: {}", shot.display());
+}
+
+fn refused(dir: &Path, args: &[&str], says: &str) {
+    let out = run(dir, args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+    assert!(stderr.contains(says), "{args:?}: expected {says:?} in {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "one clear error: {stderr}");
+}
+
+#[test]
+fn bad_input_is_refused_with_nothing_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    tracked(dir);
+    // A run folder missing a file.
+    fs::create_dir(dir.join("partial")).unwrap();
+    fs::copy(dir.join("run/frames.csv"), dir.join("partial/frames.csv")).unwrap();
+    refused(dir, &["report", "partial"], "partial/summary.json: cannot read");
+    fs::copy(dir.join("run/summary.json"), dir.join("partial/summary.json")).unwrap();
+    refused(dir, &["report", "partial"], "partial/likelihoods.csv: cannot read");
+    assert!(!dir.join("partial/report").exists());
+    // Truth of another video.
+    let other = dir.join("short.csv");
+    let truth = fs::read_to_string(dir.join("video/truth.csv")).unwrap();
+    fs::write(&other, truth.lines().take(5).collect::<Vec<_>>().join("\n") + "\n").unwrap();
+    refused(dir, &["report", "run", "--truth", "short.csv"], "they must describe the same video");
+    // Frames that are not the run's.
+    fs::create_dir(dir.join("few")).unwrap();
+    for name in ["000000.png", "000001.png"] {
+        fs::copy(dir.join("video/frames").join(name), dir.join("few").join(name)).unwrap();
+    }
+    refused(dir, &["report", "run", "--frames", "few"], "few: 2 frames, but the run tracked");
+    assert!(!dir.join("run/report").exists());
+    // An output folder that holds something.
+    fs::create_dir(dir.join("taken")).unwrap();
+    fs::write(dir.join("taken/keep.txt"), "mine").unwrap();
+    refused(dir, &["report", "run", "-o", "taken"], "taken: exists and is not empty");
+    assert_eq!(fs::read_to_string(dir.join("taken/keep.txt")).unwrap(), "mine");
+}
