@@ -63,6 +63,31 @@ fn sibling(path: &Path, what: &str) -> PathBuf {
     path.with_file_name(format!(".{name}.{what}.{}", std::process::id()))
 }
 
+/// How hard [`png`] compresses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PngEffort {
+    /// Rendered frames, thousands of them: binary masks compress well at
+    /// any level, noisy color frames hardly at all.
+    Fast,
+    /// Report pictures, kept and mailed: the smallest file is worth the time.
+    Smallest,
+}
+
+/// Pixels (`kind`: gray or RGB, 8 bits) as the bytes of a PNG file.
+pub fn png(pixels: &[u8], width: u32, height: u32, kind: image::ExtendedColorType, effort: PngEffort) -> Vec<u8> {
+    use image::ImageEncoder;
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    let (compression, filter) = match effort {
+        PngEffort::Fast => (CompressionType::Fast, FilterType::Sub),
+        PngEffort::Smallest => (CompressionType::Best, FilterType::Adaptive),
+    };
+    let mut out = Vec::with_capacity(pixels.len() / 4);
+    PngEncoder::new_with_quality(&mut out, compression, filter)
+        .write_image(pixels, width, height, kind)
+        .expect("encoding to memory cannot fail");
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -6,10 +6,10 @@
 
 mod common;
 
-use common::{chromium, imitate};
+use common::{browser_check, imitate};
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 fn shipped(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
@@ -104,41 +104,7 @@ fn a_run_becomes_a_self_contained_page_whose_numbers_are_those_of_metrics_json()
     assert!(!dir.join("baseline/report/recognition.png").exists());
     assert!(dir.join("baseline/report/filmstrip.png").is_file());
 
-    browser_check(&report.join("index.html"));
-}
-
-/// Opens the page in headless Chromium: every image must load, the console
-/// must stay silent, and a screenshot is kept in the test's target folder.
-fn browser_check(page: &Path) {
-    let Some(chromium) = chromium() else { return };
-    let url = format!("file://{}", page.display());
-    let browser = |extra: &[&str]| {
-        let out = Command::new(&chromium)
-            .args(["--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars", "--virtual-time-budget=5000"])
-            .args(["--enable-logging=stderr", "--v=0"])
-            .args(extra)
-            .arg(&url)
-            .output()
-            .unwrap();
-        assert!(out.status.success(), "chromium failed: {}", String::from_utf8_lossy(&out.stderr));
-        out
-    };
-    let out = browser(&["--dump-dom"]);
-    let dom = String::from_utf8_lossy(&out.stdout);
-    assert!(dom.contains("<body data-images-ok=\"true\">"), "not every image loaded: {}", &dom[..dom.len().min(400)]);
-    let log = String::from_utf8_lossy(&out.stderr);
-    let console: Vec<&str> = log.lines().filter(|l| l.contains("CONSOLE")).collect();
-    assert!(console.is_empty(), "the page wrote to the console: {console:?}");
-
-    let shot = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-screenshot.png");
-    let _ = fs::remove_file(&shot);
-    browser(&[&format!("--screenshot={}", shot.display()), "--window-size=1100,1400"]);
-    let image = image::open(&shot).unwrap().to_rgb8();
-    assert_eq!(image.dimensions(), (1100, 1400));
-    // Figure 8 is drawn: its colored markers and shading fill part of the view.
-    let colored = image.pixels().filter(|p| p.0.iter().max().unwrap() - p.0.iter().min().unwrap() > 60).count();
-    assert!(colored > 5000, "{colored} colored pixels in {}", shot.display());
-    eprintln!("screenshot: {}", shot.display());
+    browser_check(&report.join("index.html"), "report-screenshot.png");
 }
 
 fn refused(dir: &Path, args: &[&str], says: &str) {

@@ -4,7 +4,9 @@
 //! error (unknown flag, impossible option value).
 
 mod cluster;
+mod demo;
 mod embed;
+mod eval;
 mod export;
 mod fit;
 mod inspect;
@@ -60,6 +62,8 @@ enum Command {
     Track(track::Args),
     Score(score::Args),
     Report(report::Args),
+    Eval(eval::Args),
+    Demo(demo::Args),
 }
 
 /// How a command ended, when it did not fail outright.
@@ -76,7 +80,33 @@ pub struct UsageError(pub String);
 
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
+    let result = dispatch(cli);
+    match result {
+        Ok(Outcome::Success) => ExitCode::SUCCESS,
+        Ok(Outcome::SomeFailed) => ExitCode::from(1),
+        Err(err) => {
+            eprintln!("imitate: error: {}", describe(&err));
+            if err.downcast_ref::<UsageError>().is_some() { ExitCode::from(2) } else { ExitCode::from(1) }
+        }
+    }
+}
+
+/// Runs `imitate ARGS…` in this process, quietly: `eval` and `demo` chain
+/// the very commands a user would type, with their defaults and checks.
+pub fn invoke<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> anyhow::Result<()> {
+    let words = std::iter::once("imitate".as_ref()).chain(args.iter().map(AsRef::as_ref)).chain(["-q".as_ref()]);
+    let cli = Cli::try_parse_from(words).map_err(|e| anyhow::anyhow!("{}", e.to_string().trim()))?;
+    match dispatch(cli)? {
+        Outcome::Success => Ok(()),
+        Outcome::SomeFailed => bail!(
+            "{}: some inputs failed",
+            args.iter().map(|a| a.as_ref().to_string_lossy()).collect::<Vec<_>>().join(" ")
+        ),
+    }
+}
+
+fn dispatch(cli: Cli) -> anyhow::Result<Outcome> {
+    match cli.command {
         Command::Inspect(args) => inspect::run(args, cli.global),
         Command::Retarget(args) => retarget::run(args, cli.global),
         Command::Synth(args) => synth::run(args, cli.global),
@@ -90,14 +120,8 @@ pub fn main() -> ExitCode {
         Command::Track(args) => track::run(args, cli.global),
         Command::Score(args) => score::run(args, cli.global),
         Command::Report(args) => report::run(args, cli.global),
-    };
-    match result {
-        Ok(Outcome::Success) => ExitCode::SUCCESS,
-        Ok(Outcome::SomeFailed) => ExitCode::from(1),
-        Err(err) => {
-            eprintln!("imitate: error: {}", describe(&err));
-            if err.downcast_ref::<UsageError>().is_some() { ExitCode::from(2) } else { ExitCode::from(1) }
-        }
+        Command::Eval(args) => eval::run(args, cli.global),
+        Command::Demo(args) => demo::run(args, cli.global),
     }
 }
 

@@ -4,8 +4,6 @@ use super::retarget::RetargetArgs;
 use super::segment::load_corpus;
 use super::{Global, Outcome, UsageError, camera, note, progress, refuse_nonempty};
 use anyhow::{Context, bail};
-use image::ImageEncoder;
-use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use imitate::fsutil::{write_atomic, write_dir_atomic};
 use imitate::mocap::pose::Motion;
 use imitate::vision::color::Scene;
@@ -94,14 +92,9 @@ fn png(mask: &Mask) -> Vec<u8> {
     encode(&grey, mask.width(), mask.height(), image::ExtendedColorType::L8)
 }
 
-/// Pixels as a PNG, compressed fast: binary frames compress well whatever
-/// the level, and noisy color frames hardly at all.
+/// Pixels as a PNG, compressed fast: frames are many.
 fn encode(pixels: &[u8], width: usize, height: usize, kind: image::ExtendedColorType) -> Vec<u8> {
-    let mut out = Vec::with_capacity(pixels.len() / 4);
-    PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Sub)
-        .write_image(pixels, width as u32, height as u32, kind)
-        .expect("encoding to memory cannot fail");
-    out
+    imitate::fsutil::png(pixels, width as u32, height as u32, kind, imitate::fsutil::PngEffort::Fast)
 }
 
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {

@@ -47,7 +47,7 @@ pub struct Args {
 
 /// The silhouettes of frames `picks` of `input`, which must hold `frames`
 /// frames.
-fn silhouettes(input: &Path, frames: usize, picks: &[usize]) -> anyhow::Result<Vec<Mask>> {
+pub(super) fn silhouettes(input: &Path, frames: usize, picks: &[usize]) -> anyhow::Result<Vec<Mask>> {
     let source = FrameSource::open(input, Expect::Auto)?;
     if let Some(n) = source.frame_count().filter(|&n| n != frames) {
         bail!(

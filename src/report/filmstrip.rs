@@ -3,7 +3,7 @@
 //! camera, and the estimate seen from above; the true body too, when known.
 
 use super::metrics::Track;
-use super::plot::{color, encode_png};
+use super::plot::{color, encode_png, register_font};
 use crate::mocap::body::{JOINTS, Joint};
 use crate::vision::camera::Camera;
 use crate::vision::mask::Mask;
@@ -44,6 +44,7 @@ pub fn filmstrip(
     picks: &[usize],
     observed: &[Mask],
 ) -> Vec<u8> {
+    register_font();
     let scale = if camera.width() <= 200 { 2 } else { 1 };
     let (tw, th) = (camera.width() as u32 * scale, camera.height() as u32 * scale);
     // Blocks of up to COLUMNS frames, one under the other, each a caption

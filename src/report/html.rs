@@ -72,8 +72,9 @@ impl Page {
         self.push(&format!("<pre>{}</pre>\n", escape(text)));
     }
 
-    /// Headline numbers, each a value, a caption, and the key of the value
-    /// in `metrics.json` (kept in a `data-metric` attribute for checking).
+    /// Headline numbers, each a value, a caption, and where the value is in
+    /// `metrics.json` (a key or a JSON pointer, kept in a `data-metric`
+    /// attribute so the page can be checked against the file).
     pub fn numbers(&mut self, numbers: &[(String, String, String)]) {
         let mut html = String::from("<div class=\"numbers\">");
         for (value, caption, key) in numbers {

@@ -375,11 +375,11 @@ fn recognize(
 
 /// Six decimals: micrometres, microdegrees, microseconds, far finer than
 /// anything measured here, and the file stays readable.
-fn round6(v: f64) -> f64 {
+pub(super) fn round6(v: f64) -> f64 {
     (v * 1e6).round() / 1e6
 }
 
-fn rounded<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+pub(super) fn rounded<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_f64(round6(*v))
 }
 

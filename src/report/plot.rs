@@ -3,6 +3,7 @@
 //! DejaVu Sans, so a PNG looks the same on every machine and needs no
 //! system fonts.
 
+use crate::fsutil::{PngEffort, png};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::sync::Once;
@@ -30,7 +31,7 @@ pub fn color(i: usize) -> RGBColor {
 /// The font every chart uses; registered with plotters once.
 const FONT: &str = "sans-serif";
 
-fn register_font() {
+pub(crate) fn register_font() {
     static REGISTER: Once = Once::new();
     REGISTER.call_once(|| {
         let bytes: &'static [u8] = include_bytes!("font/DejaVuSans.ttf");
@@ -173,14 +174,9 @@ impl Figure {
     }
 }
 
-/// An RGB buffer as PNG bytes.
+/// An RGB buffer as PNG bytes, compressed hard.
 pub fn encode_png(width: u32, height: u32, rgb: Vec<u8>) -> Vec<u8> {
-    let image = image::RgbImage::from_raw(width, height, rgb).expect("the buffer is width × height × 3");
-    let mut bytes = Vec::new();
-    image
-        .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-        .expect("encoding into memory cannot fail");
-    bytes
+    png(&rgb, width, height, image::ExtendedColorType::Rgb8, PngEffort::Smallest)
 }
 
 type Drawn<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
@@ -239,9 +235,9 @@ fn draw_chart<DB: DrawingBackend>(chart: &Chart, area: &DrawingArea<DB, Shift>) 
                 let dots = series.points.iter().filter(|p| p.size > 0.0);
                 plot.draw_series(dots.map(|p| Circle::new((p.x, p.y), p.size, c.filled())))?
             }
-            Style::Markers => plot.draw_series(
-                series.points.iter().map(|p| Circle::new((p.x, p.y), p.size.max(0.5), c.mix(0.7).filled())),
-            )?,
+            Style::Markers => {
+                plot.draw_series(series.points.iter().map(|p| Circle::new((p.x, p.y), p.size.max(0.5), c.filled())))?
+            }
         };
         drawn.label(series.name.clone()).legend(move |(x, y)| Circle::new((x + 6, y), 4, c.filled()));
     }

@@ -1,7 +1,8 @@
 //! Helpers shared by the integration tests. Each test crate uses some.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::fs;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// `../shared/mocap/real`, the real captures every stage is tested on.
@@ -82,4 +83,39 @@ MOTION
 /// [`hips_chest`] with Chest at `0 10 0` rotating `Zrotation Xrotation Yrotation`.
 pub fn hips_chest_text(motion: &str) -> String {
     hips_chest("0 10 0", "3 Zrotation Xrotation Yrotation", motion)
+}
+
+/// Opens the page in headless Chromium: every image must load, the console
+/// must stay silent, and a screenshot (`screenshot`, in the tests' target
+/// folder) is kept to look at.
+pub fn browser_check(page: &Path, screenshot: &str) {
+    let Some(chromium) = chromium() else { return };
+    let url = format!("file://{}", page.display());
+    let browser = |extra: &[&str]| {
+        let out = Command::new(&chromium)
+            .args(["--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars", "--virtual-time-budget=5000"])
+            .args(["--enable-logging=stderr", "--v=0"])
+            .args(extra)
+            .arg(&url)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "chromium failed: {}", String::from_utf8_lossy(&out.stderr));
+        out
+    };
+    let out = browser(&["--dump-dom"]);
+    let dom = String::from_utf8_lossy(&out.stdout);
+    assert!(dom.contains("<body data-images-ok=\"true\">"), "not every image loaded: {}", &dom[..dom.len().min(400)]);
+    let log = String::from_utf8_lossy(&out.stderr);
+    let console: Vec<&str> = log.lines().filter(|l| l.contains("CONSOLE")).collect();
+    assert!(console.is_empty(), "the page wrote to the console: {console:?}");
+
+    let shot = Path::new(env!("CARGO_TARGET_TMPDIR")).join(screenshot);
+    let _ = fs::remove_file(&shot);
+    browser(&[&format!("--screenshot={}", shot.display()), "--window-size=1100,1400"]);
+    let image = image::open(&shot).unwrap().to_rgb8();
+    assert_eq!(image.dimensions(), (1100, 1400));
+    // Figure 8 is drawn: its colored markers and shading fill part of the view.
+    let colored = image.pixels().filter(|p| p.0.iter().max().unwrap() - p.0.iter().min().unwrap() > 60).count();
+    assert!(colored > 5000, "{colored} colored pixels in {}", shot.display());
+    eprintln!("screenshot: {}", shot.display());
 }
