@@ -1,8 +1,9 @@
 //! `imitate demo`: the main job on what ships with the program.
 
-use super::{Global, Outcome, invoke, note, progress};
+use super::eval::SEQUENCE;
+use super::{Global, Outcome, arg, invoke, note, progress};
 use anyhow::{Context, bail};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// The shipped vocabulary (vocab/default.vocab), built into the program so
 /// the demo runs from anywhere.
@@ -31,10 +32,6 @@ pub struct Args {
     /// Seed of the motion and the tracker.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-}
-
-fn arg(path: &Path) -> String {
-    path.display().to_string()
 }
 
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
@@ -75,7 +72,7 @@ fn demo(args: &Args, global: Global) -> anyhow::Result<Outcome> {
         "-o",
         &arg(&motion),
         "--sequence",
-        "circles,wave-h,wave-v",
+        SEQUENCE,
         "--reps",
         "3",
         "--seed",

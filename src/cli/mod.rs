@@ -197,6 +197,11 @@ pub fn camera(choice: &str, width: u32, height: u32) -> anyhow::Result<Camera> {
     }
 }
 
+/// A path as a command-line argument, for commands run through [`invoke`].
+pub fn arg(path: &Path) -> String {
+    path.display().to_string()
+}
+
 /// Refuses an output folder that holds something, unless `force`.
 pub fn refuse_nonempty(output: &Path, force: bool) -> anyhow::Result<()> {
     if !force && output.read_dir().is_ok_and(|mut d| d.next().is_some()) {
