@@ -139,6 +139,11 @@ fn bad_input_is_refused_with_nothing_written() {
     }
     refused(dir, &["report", "run", "--frames", "few"], "few: 2 frames, but the run tracked");
     assert!(!dir.join("run/report").exists());
+    // Frames that moved: summary.json names them relative to where track ran.
+    fs::create_dir(dir.join("elsewhere")).unwrap();
+    let run_dir = dir.join("run").display().to_string();
+    refused(&dir.join("elsewhere"), &["report", &run_dir], "(pass --frames if they moved)");
+    assert!(!dir.join("run/report").exists());
     // An output folder that holds something.
     fs::create_dir(dir.join("taken")).unwrap();
     fs::write(dir.join("taken/keep.txt"), "mine").unwrap();

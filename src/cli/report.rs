@@ -84,7 +84,10 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let metrics = truth.as_ref().map(|t| score(&run.track, t, &run.primitives, args.settle)).transpose()?;
     let input = args.frames.clone().unwrap_or_else(|| PathBuf::from(&run.summary.input));
     let picks = pick_frames(run.track.frame.len(), MAX_FRAMES);
-    let observed = silhouettes(&input, run.track.frame.len(), &picks)?;
+    let observed = silhouettes(&input, run.track.frame.len(), &picks).with_context(|| match &args.frames {
+        Some(_) => "--frames".to_string(),
+        None => format!("the frames {} names (pass --frames if they moved)", summary.display()),
+    })?;
     let truth_view = truth.as_ref().zip(metrics.as_ref()).map(|(track, metrics)| Truth { track, metrics });
     let mut files = run_report(&run, truth_view, &camera, &picks, &observed);
     if let Some(m) = &metrics {
