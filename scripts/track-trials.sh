@@ -5,7 +5,7 @@
 # table per trial. Real captures are used when ../shared/mocap/real (or
 # $IMITATE_REAL_MOCAP) exists.
 #
-#   bash scripts/track-trials.sh [WORK_DIR]        # about 2.5 minutes on 2 cores; WORK_DIR may be reused
+#   bash scripts/track-trials.sh [WORK_DIR]        # about 2 min 20 s on 2 cores; WORK_DIR may be reused
 #
 # Every number is the mean over seeds 1–5 (min–max after it).
 set -euo pipefail
@@ -83,8 +83,10 @@ for speed in 0.25 1 2 4; do
   for k in 5 1; do trial "speed$speed-K$k" "$video/frames" paper.vocab --lookahead "$k" --feedback; done
 done
 
-header "Viewpoint (6 particles, eq. 10)"
-for camera in side overhead; do trial "$camera" "video_$camera/frames" paper.vocab --feedback; done
+header "Viewpoint (eq. 10)"
+for camera in side overhead; do
+  for n in 6 25; do trial "$camera-$n" "video_$camera/frames" paper.vocab --particles "$n" --feedback; done
+done
 
 header "Baseline: the full-space annealed filter at the same likelihood budget"
 for n in 6 200; do trial "full-space-$n" video_front/frames paper.vocab --particles "$n" --baseline full-space; done

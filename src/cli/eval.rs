@@ -500,21 +500,26 @@ fn viewpoint(work: &Work, front: &Video, held_out: u64) -> anyhow::Result<Trial>
             "front" => front.clone(),
             _ => work.synth(camera, SEQUENCE, 3, held_out, 1.0, camera)?,
         };
-        let label = Label { series: "eq. 10", x: camera.into(), params: serde_json::json!({"camera": camera}) };
-        settings.push(work.setting(&video, label, &["--feedback"])?);
+        for n in ["6", "25"] {
+            let params = serde_json::json!({"camera": camera, "particles": n.parse::<u64>().expect("a number")});
+            let label =
+                Label { series: if n == "6" { "6 particles" } else { "25 particles" }, x: camera.into(), params };
+            settings.push(work.setting(&video, label, &["--particles", n, "--feedback"])?);
+        }
         overhead = Some(video);
     }
     let overhead = overhead.expect("overhead comes last");
     Ok(Trial {
         key: "viewpoint".into(),
         title: "Viewpoint".into(),
-        about: "The trial-one sequence seen from the front, the side and overhead (70° down), 6 particles, eq. 10."
+        about: "The trial-one sequence seen from the front, the side and overhead (70° down), with 6 and 25 \
+                particles per primitive, eq. 10."
             .into(),
         x_label: "camera".into(),
         charts: vec![Measure::UpperBody, Measure::Recognition],
         settings,
         pictures: vec![strip(
-            &work.run_dir(&overhead, &["--feedback"], work.seeds[0]),
+            &work.run_dir(&overhead, &["--particles", "6", "--feedback"], work.seeds[0]),
             &overhead,
             "filmstrip-overhead",
             "Overhead camera (as Figure 7).",

@@ -74,6 +74,14 @@ pub struct Estimate {
     pub x: JointVector,
     /// R of the estimate (eq. 8), or `None` on a frame with no silhouette.
     pub likelihood: Option<f64>,
+    /// What recognition weighs this primitive by, on R's scale: the
+    /// geometric mean of the estimate's R and the particles' prediction of
+    /// the frame (the power mean of their R, to the sharpness, before they
+    /// are weighted: the filter's estimate of p(z[t] | z[1:t−1], primitive)).
+    /// A primitive that fits the frame only with a pose its dynamics did
+    /// not predict scores lower than one that saw it coming. `None` on a
+    /// frame with no silhouette.
+    pub evidence: Option<f64>,
     /// Attractor progress of the estimate, in [0, 1).
     pub progress: f64,
 }
@@ -198,7 +206,7 @@ impl<'v> Filter<'v> {
             self.weights.fill(1.0 / n as f64);
             let latent = self.mean();
             let x = self.primitive.reconstruct(&latent);
-            return self.estimate(latent, x, None);
+            return self.estimate(latent, x, None, None);
         };
         let root = self.root;
         let mut scores = vec![0.0; n];
@@ -208,11 +216,13 @@ impl<'v> Filter<'v> {
         }
         // Weights relative to the best score, so the power cannot underflow all.
         let top = scores.iter().copied().fold(f64::MIN, f64::max);
+        let k = self.params.sharpness;
+        let predicted = top * (scores.iter().map(|s| (s / top).powf(k)).sum::<f64>() / n as f64).powf(1.0 / k);
         let width = self.params.manifold * step;
         let mut nearest = Vec::with_capacity(1);
         for (j, (w, s)) in self.weights.iter_mut().zip(&scores).enumerate() {
             let off = self.primitive.field().distance_to_data(&self.particles[j * d..(j + 1) * d], &mut nearest);
-            *w = (s / top).powf(self.params.sharpness) * (-0.5 * (off / width).powi(2)).exp();
+            *w = (s / top).powf(k) * (-0.5 * (off / width).powi(2)).exp();
         }
         let total: f64 = self.weights.iter().sum();
         self.weights.iter_mut().for_each(|w| *w /= total);
@@ -230,12 +240,12 @@ impl<'v> Filter<'v> {
         self.evaluations += self.params.root.steps as u64;
         self.root = root;
         self.resample();
-        self.estimate(latent, x, Some(score))
+        self.estimate(latent, x, Some(score), Some((score * predicted).sqrt()))
     }
 
-    fn estimate(&self, latent: Vec<f64>, x: JointVector, likelihood: Option<f64>) -> Estimate {
+    fn estimate(&self, latent: Vec<f64>, x: JointVector, likelihood: Option<f64>, evidence: Option<f64>) -> Estimate {
         let progress = self.primitive.progress(&latent);
-        Estimate { latent, root: self.root, x, likelihood, progress }
+        Estimate { latent, root: self.root, x, likelihood, evidence, progress }
     }
 
     /// The weighted mean of the particles.
