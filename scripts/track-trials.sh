@@ -5,7 +5,7 @@
 # table per trial. Real captures are used when ../shared/mocap/real (or
 # $IMITATE_REAL_MOCAP) exists.
 #
-#   bash scripts/track-trials.sh [WORK_DIR]        # about 2 min 20 s on 2 cores; WORK_DIR may be reused
+#   bash scripts/track-trials.sh [WORK_DIR]        # about 2.5 minutes on 2 cores; WORK_DIR may be reused
 #
 # Every number is the mean over seeds 1–5 (min–max after it).
 set -euo pipefail
@@ -87,6 +87,10 @@ header "Viewpoint (eq. 10)"
 for camera in side overhead; do
   for n in 6 25; do trial "$camera-$n" "video_$camera/frames" paper.vocab --particles "$n" --feedback; done
 done
+
+header "Silhouettes extracted from color frames (front, background subtraction, eq. 10)"
+"$imitate" -q render seq_front/sequence.bvh -o video_color --labels seq_front/labels.csv --color --force
+for n in 6 25; do trial "color-$n" video_color/color paper.vocab --particles "$n" --feedback; done
 
 header "Baseline: the full-space annealed filter at the same likelihood budget"
 for n in 6 200; do trial "full-space-$n" video_front/frames paper.vocab --particles "$n" --baseline full-space; done
