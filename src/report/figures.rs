@@ -4,10 +4,9 @@
 //! error over time.
 
 use super::Curves;
-use super::metrics::{Track, UPPER_BODY};
+use super::metrics::{Track, UPPER_BODY, root_relative_m};
 use super::plot::{Chart, Figure, Point, Series, Span, Style};
 use super::run::Run;
-use crate::mocap::body::Joint;
 
 /// Chart width, pixels.
 pub const WIDTH: u32 = 760;
@@ -107,14 +106,12 @@ fn relative_likelihoods(curves: &Curves, sharpness: f64) -> Vec<Vec<Option<f64>>
 
 /// Root-relative upper-body error (mm) of each frame.
 pub fn upper_body_error(estimate: &Track, truth: &Track) -> Vec<f64> {
-    let pelvis = Joint::Pelvis.index();
     estimate
         .joints
         .iter()
         .zip(&truth.joints)
         .map(|(e, t)| {
-            let sum: f64 =
-                UPPER_BODY.iter().map(|j| (e[j.index()] - e[pelvis]).distance(t[j.index()] - t[pelvis])).sum();
+            let sum: f64 = UPPER_BODY.iter().map(|j| root_relative_m(e, t, j.index())).sum();
             1000.0 * sum / UPPER_BODY.len() as f64
         })
         .collect()

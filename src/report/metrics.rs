@@ -187,6 +187,13 @@ const LIMBS: [[(Joint, Joint); 2]; 4] = [
     [(Joint::LeftKnee, Joint::LeftAnkle), (Joint::RightKnee, Joint::RightAnkle)],
 ];
 
+/// How far joint `j` is from the truth once each body's own pelvis is
+/// subtracted (m): the root-relative error of one joint on one frame.
+pub fn root_relative_m(estimate: &[DVec3; JOINTS], truth: &[DVec3; JOINTS], j: usize) -> f64 {
+    let pelvis = Joint::Pelvis.index();
+    (estimate[j] - estimate[pelvis]).distance(truth[j] - truth[pelvis])
+}
+
 /// Scores `estimate` (a run's `frames.csv`) against `truth` (the render's
 /// `truth.csv`), row by row; the rows must be the same frames. A frame
 /// counts as a switch of activity, and starts a settling window of
@@ -202,10 +209,9 @@ pub fn score(estimate: &Track, truth: &Track, primitives: &Primitives, settle_s:
         estimate.joints.iter().zip(&truth.joints).zip(estimate.root.iter().zip(&truth.root))
     {
         root += est_root.distance(*tru_root);
-        let (est_pelvis, tru_pelvis) = (est[Joint::Pelvis.index()], tru[Joint::Pelvis.index()]);
         for j in 0..JOINTS {
             absolute += est[j].distance(tru[j]);
-            relative[j] += (est[j] - est_pelvis).distance(tru[j] - tru_pelvis);
+            relative[j] += root_relative_m(est, tru, j);
         }
     }
     // Per-joint sums over frames, so a joint set's mean is its sums' mean.
