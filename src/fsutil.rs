@@ -1,5 +1,7 @@
 //! Writing output files so that a failure never leaves a partial file: write
-//! to a temporary file beside the target, then rename it into place.
+//! to a temporary file beside the target, then rename it into place. Also
+//! what several writers share: PNG encoding and JSON numbers rounded to six
+//! decimals.
 
 use std::fs;
 use std::io::{self, BufWriter, Write};
@@ -86,6 +88,23 @@ pub fn png(pixels: &[u8], width: u32, height: u32, kind: image::ExtendedColorTyp
         .write_image(pixels, width, height, kind)
         .expect("encoding to memory cannot fail");
     out
+}
+
+/// Six decimals: micrometres, microdegrees, microseconds, far finer than
+/// anything measured here, and the file stays readable.
+pub fn round6(v: f64) -> f64 {
+    (v * 1e6).round() / 1e6
+}
+
+pub fn rounded<S: serde::Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64(round6(*v))
+}
+
+pub fn rounded_option<S: serde::Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+    match v {
+        Some(v) => s.serialize_some(&round6(*v)),
+        None => s.serialize_none(),
+    }
 }
 
 #[cfg(test)]

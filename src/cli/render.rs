@@ -1,11 +1,10 @@
 //! `imitate render`: test videos with ground truth, from any BVH.
 
 use super::retarget::RetargetArgs;
-use super::segment::load_corpus;
+use super::segment::take;
 use super::{Global, Outcome, UsageError, camera, note, progress, refuse_nonempty};
-use anyhow::{Context, bail};
+use anyhow::Context;
 use imitate::fsutil::{write_atomic, write_dir_atomic};
-use imitate::mocap::pose::Motion;
 use imitate::vision::color::Scene;
 use imitate::vision::mask::Mask;
 use imitate::vision::noise::{Level, Noise};
@@ -74,18 +73,6 @@ fn parse_size(text: &str) -> Result<(u32, u32), UsageError> {
     Ok((w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?))
 }
 
-/// The take and, when labelled, each of its frames' activity.
-fn take(args: &Args, global: Global) -> anyhow::Result<(Motion, Option<Vec<String>>)> {
-    if args.input.is_dir() {
-        bail!("{}: is a folder; render takes one BVH file", args.input.display());
-    }
-    let input = std::slice::from_ref(&args.input);
-    let mut corpus = load_corpus(input, args.labels.as_deref(), &args.retarget.options()?, global)?;
-    let recording = corpus.takes.pop().expect("one input gives one take");
-    let names = recording.labels.map(|ids| ids.iter().map(|&id| corpus.label(id).to_string()).collect());
-    Ok((recording.motion, names))
-}
-
 /// One frame as an 8-bit grey PNG: 0 outside, 255 on the body.
 fn png(mask: &Mask) -> Vec<u8> {
     let grey: Vec<u8> = mask.pixels().iter().map(|&p| p * 255).collect();
@@ -105,7 +92,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let camera = camera(&args.camera, width, height)?;
     refuse_nonempty(&args.output, args.force)?;
     let started = Instant::now();
-    let (motion, labels) = take(&args, global)?;
+    let (motion, labels) = take(&args.input, args.labels.as_deref(), &args.retarget, global)?;
     let times: Vec<f64> = (0..).map(|k| k as f64 / args.fps).take_while(|&t| t <= motion.duration_s() + 1e-9).collect();
     let bar = progress(global, times.len() as u64, "render");
     let noise = Noise::new(args.noise, args.seed, &camera, times.len(), args.fps);

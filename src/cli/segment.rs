@@ -1,8 +1,10 @@
 //! `imitate segment`: cut takes into segments.
 
 use super::learn::{SegmentArgs, TakesArgs};
+use super::retarget::RetargetArgs;
 use super::{Global, Outcome, count, note, progress};
-use anyhow::Context;
+use anyhow::{Context, bail};
+use imitate::mocap::pose::Motion;
 use imitate::mocap::retarget::RetargetOptions;
 use imitate::vocab::corpus::{self, Corpus, read_labels};
 use imitate::vocab::pipeline::segment_corpus;
@@ -45,6 +47,23 @@ pub fn load_corpus(
         }
     }
     Ok(corpus)
+}
+
+/// One take (any skeleton: it is retargeted) and, when labelled, each of
+/// its frames' activity: what `render` and `execute` read.
+pub fn take(
+    input: &Path,
+    labels: Option<&Path>,
+    retarget: &RetargetArgs,
+    global: Global,
+) -> anyhow::Result<(Motion, Option<Vec<String>>)> {
+    if input.is_dir() {
+        bail!("{}: is a folder; give one BVH file", input.display());
+    }
+    let mut corpus = load_corpus(&[input.to_path_buf()], labels, &retarget.options()?, global)?;
+    let recording = corpus.takes.pop().expect("one input gives one take");
+    let names = recording.labels.map(|ids| ids.iter().map(|&id| corpus.label(id).to_string()).collect());
+    Ok((recording.motion, names))
 }
 
 /// The takes a corpus was read from, for error messages: up to three

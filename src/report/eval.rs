@@ -4,9 +4,9 @@
 //! scored runs into the report.
 
 use super::html::Page;
-use super::metrics::round6;
 use super::page::File;
 use super::plot::{Chart, Figure, Point, Series, Style};
+use crate::fsutil::round6;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -24,11 +24,11 @@ pub struct RunScore {
 /// A measure over seeds: mean, smallest, largest.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Spread {
-    #[serde(serialize_with = "super::metrics::rounded")]
+    #[serde(serialize_with = "crate::fsutil::rounded")]
     pub mean: f64,
-    #[serde(serialize_with = "super::metrics::rounded")]
+    #[serde(serialize_with = "crate::fsutil::rounded")]
     pub min: f64,
-    #[serde(serialize_with = "super::metrics::rounded")]
+    #[serde(serialize_with = "crate::fsutil::rounded")]
     pub max: f64,
 }
 
@@ -72,7 +72,7 @@ pub struct SettingSummary {
     /// Settled recognition accuracy (a share); `null` for runs that name no
     /// activity (the baseline) or score none.
     pub recognition_settled: Option<Spread>,
-    #[serde(serialize_with = "super::metrics::rounded")]
+    #[serde(serialize_with = "crate::fsutil::rounded")]
     pub likelihood_evaluations_per_frame: f64,
 }
 

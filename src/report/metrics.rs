@@ -2,9 +2,10 @@
 //! limb direction errors, activity recognition and how quickly a switch of
 //! activity is recognized, from the run's frames and the render's truth.
 
+use crate::fsutil::{rounded, rounded_option};
 use crate::mocap::body::{JOINTS, Joint};
 use glam::DVec3;
-use serde::{Serialize, Serializer};
+use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Why a run could not be scored. Every message names the file at fault.
@@ -376,23 +377,6 @@ fn recognize(
         switches_recognized: latencies.len(),
         switch_latency_s: (!latencies.is_empty()).then(|| latencies.iter().sum::<f64>() / latencies.len() as f64),
         confusion,
-    }
-}
-
-/// Six decimals: micrometres, microdegrees, microseconds, far finer than
-/// anything measured here, and the file stays readable.
-pub(super) fn round6(v: f64) -> f64 {
-    (v * 1e6).round() / 1e6
-}
-
-pub(super) fn rounded<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
-    s.serialize_f64(round6(*v))
-}
-
-fn rounded_option<S: Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
-    match v {
-        Some(v) => s.serialize_some(&round6(*v)),
-        None => s.serialize_none(),
     }
 }
 
