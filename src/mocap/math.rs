@@ -124,6 +124,28 @@ pub fn log_map(q: DQuat) -> DVec3 {
     v * (angle / s)
 }
 
+/// The angle of the rotation from `a` to `b`, radians in [0, π].
+pub fn angle_between(a: DQuat, b: DQuat) -> f64 {
+    log_map(a.inverse() * b).length()
+}
+
+/// How fast `exp_map(v)` turns while `v` changes at `v_dot`: its angular
+/// velocity in the frame it is expressed in, the left Jacobian of the
+/// rotation group at `v` applied to `v_dot`.
+pub fn exp_map_rate(v: DVec3, v_dot: DVec3) -> DVec3 {
+    let t2 = v.length_squared();
+    // (1 − cos θ)/θ² and (θ − sin θ)/θ³, by their series near 0 where the
+    // closed forms cancel.
+    let (a, b) = if t2 < 1e-4 {
+        (0.5 - t2 / 24.0, 1.0 / 6.0 - t2 / 120.0)
+    } else {
+        let t = t2.sqrt();
+        ((1.0 - t.cos()) / t2, (t - t.sin()) / (t2 * t))
+    };
+    let c = v.cross(v_dot);
+    v_dot + a * c + b * v.cross(c)
+}
+
 /// Signed angle of the rotation `q` about the unit `axis`, assuming `q` is
 /// (close to) a rotation about that axis.
 pub fn hinge_angle(q: DQuat, axis: DVec3) -> f64 {
@@ -188,8 +210,21 @@ mod tests {
         EulerOrder([Axis::Z, Axis::Y, Axis::X]),
     ];
 
-    fn angle_between(a: DQuat, b: DQuat) -> f64 {
-        log_map(a.inverse() * b).length()
+    #[test]
+    fn exp_map_rate_is_the_rate_of_turn_of_the_exponential_map() {
+        let h = 1e-7;
+        for (v, v_dot) in [
+            (DVec3::new(0.4, -0.9, 1.3), DVec3::new(0.7, 0.2, -1.1)),
+            (DVec3::new(1e-3, 2e-3, -1e-3), DVec3::new(-0.3, 0.5, 0.9)),
+            (DVec3::new(0.0, 3.0, 0.0), DVec3::new(1.0, 0.0, 0.5)),
+        ] {
+            let numeric = log_map(exp_map(v + h * v_dot) * exp_map(v).inverse()) / h;
+            let analytic = exp_map_rate(v, v_dot);
+            assert!((numeric - analytic).length() < 1e-5, "{v}: {numeric} vs {analytic}");
+        }
+        // Along the rotation's own axis the rate is the change itself.
+        let v = DVec3::new(0.3, 0.4, 1.2);
+        assert!((exp_map_rate(v, 2.0 * v) - 2.0 * v).length() < 1e-15);
     }
 
     #[test]
