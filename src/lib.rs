@@ -5,11 +5,14 @@
 //! humanoid, retargeting, the procedural demonstrator), [`vocab`] (learning
 //! a vocabulary of primitives), [`vision`] (camera, the body drawn as
 //! capsules, distance transforms and the eq. 8–9 likelihood) and [`track`]
-//! (per-primitive particle filters, recognition, the virtual trajectory).
+//! (per-primitive particle filters, recognition, the virtual trajectory),
+//! [`sim`] (the trajectory played on a simulated humanoid) and [`report`]
+//! (metrics, plots and pages).
 
 pub mod fsutil;
 pub mod mocap;
 pub mod report;
+pub mod sim;
 pub mod track;
 pub mod vision;
 pub mod vocab;

@@ -22,7 +22,7 @@ fn version_and_help_list_the_built_subcommands() {
     let help = stdout_of(&imitate().arg("--help").output().unwrap());
     let built = [
         "inspect", "retarget", "synth", "segment", "embed", "cluster", "fit", "export", "vocab", "render", "track",
-        "score",
+        "score", "execute", "report", "eval", "demo",
     ];
     for sub in built.iter().chain(&["--quiet"]) {
         assert!(help.contains(sub), "help lacks {sub}:\n{help}");
@@ -38,8 +38,9 @@ fn version_and_help_list_the_built_subcommands() {
 fn usage_errors_exit_with_code_2_and_say_what_is_wrong() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("out");
-    let cases: [(&[&str], &str); 7] = [
-        (&["execute"], "unrecognized subcommand"),
+    let cases: [(&[&str], &str); 8] = [
+        (&["juggle"], "unrecognized subcommand"),
+        (&["execute", "in.bvh"], "--output"),
         (&["track"], "--vocab"),
         (&["synth", "-o", out_dir.to_str().unwrap(), "--speed", "5"], "5 is outside 0.25 to 4"),
         (&["synth", "-o", out_dir.to_str().unwrap(), "--activities", "juggling"], "unknown activity `juggling`"),

@@ -7,6 +7,7 @@ mod cluster;
 mod demo;
 mod embed;
 mod eval;
+mod execute;
 mod export;
 mod fit;
 mod inspect;
@@ -61,6 +62,7 @@ enum Command {
     Render(render::Args),
     Track(track::Args),
     Score(score::Args),
+    Execute(execute::Args),
     Report(report::Args),
     Eval(eval::Args),
     Demo(demo::Args),
@@ -119,6 +121,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Render(args) => render::run(args, cli.global),
         Command::Track(args) => track::run(args, cli.global),
         Command::Score(args) => score::run(args, cli.global),
+        Command::Execute(args) => execute::run(args, cli.global),
         Command::Report(args) => report::run(args, cli.global),
         Command::Eval(args) => eval::run(args, cli.global),
         Command::Demo(args) => demo::run(args, cli.global),

@@ -54,6 +54,18 @@ const PARTS: [(Span, f64); 17] = {
 /// How many capsules a body is drawn with.
 pub const CAPSULES: usize = PARTS.len();
 
+/// Radius of the capsule along the bone that leaves `j`, as a share of
+/// standing height; the trunk's joints (pelvis, spine, chest) share the
+/// trunk's middle capsule.
+pub fn bone_radius_share(j: Joint) -> f64 {
+    let along = |span: &Span| match *span {
+        Span::Joints(from, to) => from == j && j.bone_child() == Some(to),
+        Span::Bone(from) => from == j,
+    };
+    let trunk = PARTS[CAPSULES - 1].1;
+    PARTS.iter().find(|(span, _)| along(span)).map_or(trunk, |part| part.1)
+}
+
 /// The body's capsules in a posed frame.
 pub fn capsules(body: &Body, frame: &BodyFrame) -> [Capsule; CAPSULES] {
     let height = body.proportions.height_m;

@@ -1,0 +1,34 @@
+//! Simulation speed: the shipped wave-h take (30 Hz, 12.9 s) played on the
+//! humanoid at 240 Hz, on a fixed base and standing on the ground (with
+//! balance). Each iteration builds the humanoid and plays the whole take,
+//! as `imitate execute` does. Throughput is physics steps a second; at
+//! 240 Hz the real-time factor is that over 240.
+//!
+//!     taskset -c 0 cargo bench --bench execute      (one core)
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use imitate::sim::execute::{ExecuteParams, execute};
+use imitate::sim::humanoid::Base;
+use imitate::vocab::corpus;
+use std::path::Path;
+
+fn simulate(c: &mut Criterion) {
+    let take = Path::new(env!("CARGO_MANIFEST_DIR")).join("mocap/wave-h.bvh");
+    let corpus = corpus::load(&[take], &Default::default(), None).expect("the shipped take reads");
+    let motion = &corpus.takes[0].motion;
+    let mut group = c.benchmark_group("execute_240hz");
+    group.sample_size(10);
+    for (name, base) in [("fixed_base", Base::Fixed), ("free_base", Base::Free)] {
+        let params =
+            ExecuteParams { base, ..ExecuteParams::default() }.check().expect("the standard settings are valid");
+        let steps = execute(motion, &params, || {}).expect("the take plays").summary.steps;
+        group.throughput(Throughput::Elements(steps as u64));
+        group.bench_function(BenchmarkId::new(name, format!("{:.1}s", motion.duration_s())), |b| {
+            b.iter(|| execute(motion, &params, || {}).expect("the take plays").summary.rms_error_deg)
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, simulate);
+criterion_main!(benches);

@@ -1,0 +1,162 @@
+//! `imitate execute`: a trajectory played on the simulated humanoid.
+
+use super::retarget::RetargetArgs;
+use super::segment::take;
+use super::{Global, Outcome, UsageError, note, progress, refuse_nonempty};
+use anyhow::Context;
+use imitate::fsutil::{write_atomic, write_dir_atomic};
+use imitate::mocap::bvh::write_bvh;
+use imitate::sim::execute::{ExecuteParams, ExecuteParamsError, Summary, bind_pose_start, execute};
+use imitate::sim::humanoid::{Base, Gains};
+use std::io::Write;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Play a trajectory on a simulated humanoid (rapier3d): the canonical body
+/// as rigid capsules with anthropometric masses, a motor on every joint
+/// following the trajectory's angles (interpolated to the physics rate)
+/// under gravity, within joint and torque limits. Without --fixed-base it
+/// stands on the ground and may fall, which the summary reports.
+///
+/// Any BVH goes in (it is retargeted first): `track`'s trajectory.bvh,
+/// `synth` output, motion capture. Writes DIR/executed.bvh,
+/// DIR/execution.csv and DIR/summary.json (see the README).
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The trajectory: a BVH file.
+    pub input: PathBuf,
+    /// The folder to write (refused if it exists and is not empty, unless
+    /// --force).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Hold the pelvis fixed where the trajectory starts (a humanoid on a
+    /// stand, no ground): upper-body imitation.
+    #[arg(long)]
+    pub fixed_base: bool,
+    /// On a free base, leave the ankles to the trajectory alone: no
+    /// balance (by default their targets are offset to keep the centre of
+    /// mass over the feet).
+    #[arg(long)]
+    pub no_balance: bool,
+    /// Motor stiffness and damping per unit of the inertia each joint
+    /// turns, KP (1/s²) and KD (1/s): √KP is the joints' natural frequency
+    /// (rad/s), KD / (2√KP) their damping ratio.
+    #[arg(long, value_name = "KP,KD", default_value = "10000,200", allow_hyphen_values = true)]
+    pub gains: String,
+    /// Physics steps a second; rounded up to a whole number of steps per
+    /// frame of the trajectory.
+    #[arg(long, value_name = "HZ", default_value_t = 240.0, allow_hyphen_values = true)]
+    pub rate: f64,
+    /// Leave out the trajectory's first N frames (a bind pose many motion
+    /// capture files start with, which no body can leave in one frame).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub skip: usize,
+    #[command(flatten)]
+    pub retarget: RetargetArgs,
+    /// Replace the output folder if it exists.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// `KP,KD`.
+fn parse_gains(text: &str) -> Result<Gains, UsageError> {
+    let bad = || UsageError(format!("--gains {text}: expected KP,KD, two positive numbers, e.g. 10000,200"));
+    let (kp, kd) = text.split_once(',').ok_or_else(bad)?;
+    Ok(Gains { kp_per_s2: kp.trim().parse().map_err(|_| bad())?, kd_per_s: kd.trim().parse().map_err(|_| bad())? })
+}
+
+/// summary.json: the input and the frames left out of it, then the
+/// execution's numbers.
+#[derive(serde::Serialize)]
+struct SummaryFile<'a> {
+    input: String,
+    skipped_frames: usize,
+    #[serde(flatten)]
+    summary: &'a Summary,
+}
+
+pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
+    let base = if args.fixed_base { Base::Fixed } else { Base::Free };
+    let params =
+        ExecuteParams { base, balance: !args.no_balance, gains: parse_gains(&args.gains)?, rate_hz: args.rate }
+            .check()
+            .map_err(|e| {
+                let flag = match e {
+                    ExecuteParamsError::Kp(_) | ExecuteParamsError::Kd(_) => format!("--gains {}", args.gains),
+                    ExecuteParamsError::Rate(_) => format!("--rate {}", args.rate),
+                };
+                UsageError(format!("{flag}: {e}"))
+            })?;
+    refuse_nonempty(&args.output, args.force)?;
+    let (mut motion, _) = take(&args.input, None, &args.retarget, global)?;
+    if args.skip >= motion.poses.len() && !motion.poses.is_empty() {
+        return Err(UsageError(format!(
+            "--skip {}: {} has only {} frames",
+            args.skip,
+            args.input.display(),
+            motion.poses.len()
+        ))
+        .into());
+    }
+    motion.poses.drain(..args.skip.min(motion.poses.len()));
+    let input = args.input.display().to_string();
+    if let Some((joint, first, later)) = bind_pose_start(&motion) {
+        note(
+            global,
+            &format!(
+                "{input}: warning: {} turns {:.0}° from the first frame to the next, where nine in ten \
+                 later frames turn no joint more than {:.0}°: a bind pose? --skip 1 leaves it out",
+                joint.name(),
+                first.to_degrees(),
+                later.to_degrees()
+            ),
+        );
+    }
+    let bar = progress(global, motion.poses.len() as u64, "execute");
+    let started = Instant::now();
+    let execution = execute(&motion, &params, || bar.inc(1)).with_context(|| input.clone())?;
+    let seconds = started.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+
+    let summary = &execution.summary;
+    let json = serde_json::to_string_pretty(&SummaryFile { input: input.clone(), skipped_frames: args.skip, summary })
+        .expect("the summary serializes")
+        + "\n";
+    let output = args.output.display().to_string();
+    let io = |e: std::io::Error| anyhow::anyhow!("{output}: cannot write: {e}");
+    write_dir_atomic(
+        &args.output,
+        |dir| {
+            write_atomic(&dir.join("executed.bvh"), |w| write_bvh(&execution.motion().to_bvh(), w)).map_err(io)?;
+            write_atomic(&dir.join("execution.csv"), |w| {
+                w.write_all(execution.csv_header().as_bytes())?;
+                (0..execution.frames.len()).try_for_each(|k| w.write_all(execution.csv_row(k).as_bytes()))
+            })
+            .map_err(io)?;
+            std::fs::write(dir.join("summary.json"), json).map_err(io)
+        },
+        io,
+    )?;
+    let fell = match summary.fell_at_s {
+        Some(t) => format!(", fell at {t:.2} s"),
+        None if base == Base::Free => ", stayed up".to_string(),
+        None => String::new(),
+    };
+    note(
+        global,
+        &format!(
+            "{input}: {} frames, {:.2} s at {:.0} Hz ({} base): joint error {:.2}° RMS, {:.2}° at worst{fell} → {output}\n\
+             simulated {:.2} s in {seconds:.3} s on one core ({:.0}× real time, {:.1} µs a step)",
+            summary.frames,
+            summary.duration_s,
+            summary.rate_hz,
+            if base == Base::Fixed { "fixed" } else { "free" },
+            summary.rms_error_deg,
+            summary.max_error_deg,
+            summary.duration_s,
+            summary.duration_s / seconds,
+            seconds * 1e6 / summary.steps.max(1) as f64,
+        ),
+    );
+    Ok(Outcome::Success)
+}

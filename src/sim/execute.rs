@@ -1,0 +1,356 @@
+//! Playing a trajectory on the simulated humanoid: the motors follow its
+//! rotations, interpolated to the physics rate, and every frame records
+//! what was asked, what the humanoid did and what it cost.
+
+use super::anthropometry::body_mass_kg;
+use super::humanoid::{Base, Gains, Humanoid};
+use super::targets::{JointTarget, Targets, TargetsError, motorized};
+use crate::fsutil::rounded;
+use crate::mocap::body::{JOINTS, Joint, Kind};
+use crate::mocap::math::{angle_between, exp_map};
+use crate::mocap::pose::{Motion, Pose};
+use glam::DVec3;
+use std::fmt::Write;
+
+/// How to execute a trajectory; [`ExecuteParams::check`] validates it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExecuteParams {
+    pub base: Base,
+    /// On a free base, turn the ankles' targets to keep the centre of mass
+    /// over the feet ([`Humanoid::balance`]).
+    pub balance: bool,
+    pub gains: Gains,
+    /// Physics steps a second; rounded up to a whole number of steps per
+    /// frame of the trajectory.
+    pub rate_hz: f64,
+}
+
+impl Default for ExecuteParams {
+    fn default() -> Self {
+        ExecuteParams { base: Base::Free, balance: true, gains: Gains::STANDARD, rate_hz: 240.0 }
+    }
+}
+
+/// Settings that passed [`ExecuteParams::check`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ValidExecuteParams(ExecuteParams);
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ExecuteParamsError {
+    #[error("the stiffness gain must be a positive number (1/s²), not {0}")]
+    Kp(f64),
+    #[error("the damping gain must be a positive number (1/s), not {0}")]
+    Kd(f64),
+    #[error("the physics rate must be a number of steps a second in (0, {max}], not {0}", max = ExecuteParams::MAX_RATE_HZ)]
+    Rate(f64),
+}
+
+impl ExecuteParams {
+    /// Beyond this a step is shorter than rapier's f32 time resolves well.
+    pub const MAX_RATE_HZ: f64 = 100_000.0;
+
+    pub fn check(self) -> Result<ValidExecuteParams, ExecuteParamsError> {
+        let Gains { kp_per_s2: kp, kd_per_s: kd } = self.gains;
+        if !(kp.is_finite() && kp > 0.0) {
+            return Err(ExecuteParamsError::Kp(kp));
+        }
+        if !(kd.is_finite() && kd > 0.0) {
+            return Err(ExecuteParamsError::Kd(kd));
+        }
+        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0 && self.rate_hz <= Self::MAX_RATE_HZ) {
+            return Err(ExecuteParamsError::Rate(self.rate_hz));
+        }
+        Ok(ValidExecuteParams(self))
+    }
+}
+
+/// One frame of an execution.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExecutedFrame {
+    pub time_s: f64,
+    /// The pose the humanoid was in.
+    pub achieved: Pose,
+    /// Per joint, the torque its motors applied in the step that ended
+    /// here (N·m, in the parent's frame; zero on the first frame and for
+    /// the pelvis).
+    pub torque: [DVec3; JOINTS],
+    /// Per joint, the angle between the rotation asked for (relative to its
+    /// parent) and the one reached, radians; the pelvis's is between the
+    /// tilts (its turn in the world after its heading), which no motor
+    /// drives.
+    pub error_rad: [f64; JOINTS],
+}
+
+/// A trajectory played on the humanoid.
+#[derive(Clone, Debug)]
+pub struct Execution {
+    /// What was asked: the trajectory inside the joints' limits.
+    pub targets: Targets,
+    pub frames: Vec<ExecutedFrame>,
+    pub summary: Summary,
+    body: crate::mocap::body::Body,
+}
+
+/// The numbers of an execution (`summary.json`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Summary {
+    pub format: &'static str,
+    pub frames: usize,
+    pub frame_time_s: f64,
+    pub duration_s: f64,
+    pub base: Base,
+    /// Whether the ankles balanced (a free base only).
+    pub balance: bool,
+    /// The rate the physics ran at: the one asked for, rounded up to a
+    /// whole number of steps per frame.
+    pub rate_hz: f64,
+    pub steps: usize,
+    pub gains: Gains,
+    #[serde(serialize_with = "rounded")]
+    pub height_m: f64,
+    #[serde(serialize_with = "rounded")]
+    pub mass_kg: f64,
+    /// Over every actuated joint and every frame after the first.
+    #[serde(serialize_with = "rounded")]
+    pub rms_error_deg: f64,
+    #[serde(serialize_with = "rounded")]
+    pub max_error_deg: f64,
+    /// The pelvis's tilt against the trajectory's: no motor drives it.
+    #[serde(serialize_with = "rounded")]
+    pub pelvis_tilt_rms_error_deg: f64,
+    /// Frames on which some joint lay beyond its limits.
+    pub clamped_frames: usize,
+    /// The widest a joint came apart at any frame, mm (rapier's impulse
+    /// joints hold by the solver, so not exactly zero).
+    #[serde(serialize_with = "rounded")]
+    pub max_joint_gap_mm: f64,
+    pub fell: bool,
+    pub fell_at_s: Option<f64>,
+    pub joints: Vec<JointSummary>,
+}
+
+/// One actuated joint's numbers.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct JointSummary {
+    pub joint: &'static str,
+    #[serde(serialize_with = "rounded")]
+    pub rms_error_deg: f64,
+    #[serde(serialize_with = "rounded")]
+    pub max_error_deg: f64,
+    /// The largest torque its motors applied together in any step.
+    #[serde(serialize_with = "rounded")]
+    pub peak_torque_nm: f64,
+    /// The most each of its motors may apply.
+    #[serde(serialize_with = "rounded")]
+    pub torque_limit_nm: f64,
+    /// Share of steps in which one of its motors was at that limit.
+    #[serde(serialize_with = "rounded")]
+    pub torque_limited_share: f64,
+    /// Frames on which it lay beyond its limits (and was turned back to
+    /// them), and by how much at most.
+    pub clamped_frames: usize,
+    #[serde(serialize_with = "rounded")]
+    pub clamped_by_deg: f64,
+}
+
+/// The humanoid has fallen when its pelvis is below this share of its
+/// standing height, or its trunk leans further than [`FALLEN_LEAN_RAD`].
+const FALLEN_PELVIS_SHARE: f64 = 0.5;
+const FALLEN_LEAN_RAD: f64 = std::f64::consts::FRAC_PI_3;
+
+/// Plays `motion` on the humanoid of its body. `progress` hears of every
+/// frame done.
+pub fn execute(
+    motion: &Motion,
+    params: &ValidExecuteParams,
+    mut progress: impl FnMut(),
+) -> Result<Execution, TargetsError> {
+    let ExecuteParams { base, balance, gains, rate_hz } = params.0;
+    let balance = balance && base == Base::Free;
+    let targets = Targets::new(motion)?;
+    let frame_time = targets.frame_time_s();
+    let steps_per_frame = ((rate_hz * frame_time) - 1e-9).ceil().max(1.0) as usize;
+    let dt = frame_time / steps_per_frame as f64;
+    let mut asked = [JointTarget::REST; JOINTS];
+    targets.sample(0.0, &mut asked);
+    let mut humanoid = Humanoid::new(&motion.body, base, targets.pose(0), &asked, dt);
+    let (mut torque, mut at_limit) = ([DVec3::ZERO; JOINTS], [false; JOINTS]);
+    let mut peak = [0.0f64; JOINTS];
+    let mut limited_steps = [0usize; JOINTS];
+    let mut fell_at_s = None;
+    let mut max_joint_gap_m = 0.0f64;
+    let standing = motion.body.pelvis_height();
+
+    let mut frames = Vec::with_capacity(targets.frames());
+    let mut record = |k: usize, humanoid: &Humanoid, torque: [DVec3; JOINTS]| {
+        let achieved = humanoid.pose();
+        let asked = targets.pose(k);
+        let tilt = |p: &Pose| exp_map(DVec3::from_slice(p.joint(Joint::Pelvis)));
+        let mut error_rad = Joint::ALL.map(|j| angle_between(asked.local_rotation(j), achieved.local_rotation(j)));
+        error_rad[Joint::Pelvis.index()] = angle_between(tilt(asked), tilt(&achieved));
+        frames.push(ExecutedFrame { time_s: k as f64 * frame_time, achieved, torque, error_rad });
+    };
+    record(0, &humanoid, torque);
+    progress();
+    for k in 1..targets.frames() {
+        for s in 1..=steps_per_frame {
+            let time_s = (k - 1) as f64 * frame_time + s as f64 * dt;
+            targets.sample(time_s, &mut asked);
+            if balance {
+                humanoid.balance(&mut asked);
+            }
+            humanoid.step(&asked, gains);
+            humanoid.torques(&mut torque, &mut at_limit);
+            for j in motorized() {
+                peak[j.index()] = peak[j.index()].max(torque[j.index()].length());
+                limited_steps[j.index()] += usize::from(at_limit[j.index()]);
+            }
+            if fell_at_s.is_none() && base == Base::Free && fallen(&humanoid, standing) {
+                fell_at_s = Some(time_s);
+            }
+        }
+        record(k, &humanoid, torque);
+        max_joint_gap_m = max_joint_gap_m.max(humanoid.largest_joint_gap_m());
+        progress();
+    }
+
+    let steps = (targets.frames() - 1) * steps_per_frame;
+    // The first frame is where the humanoid was put, not where it went.
+    let scored = if frames.len() > 1 { &frames[1..] } else { &frames[..] };
+    let errors = |j: Joint| scored.iter().map(move |f| f.error_rad[j.index()]);
+    let rms_deg = |errors: &mut dyn Iterator<Item = f64>| {
+        let (squares, count) = errors.fold((0.0, 0usize), |(s, c), e| (s + e * e, c + 1));
+        (squares / count.max(1) as f64).sqrt().to_degrees()
+    };
+    let max_deg = |errors: &mut dyn Iterator<Item = f64>| errors.fold(0.0, f64::max).to_degrees();
+    let joints = motorized()
+        .map(|j| JointSummary {
+            joint: j.name(),
+            rms_error_deg: rms_deg(&mut errors(j)),
+            max_error_deg: max_deg(&mut errors(j)),
+            peak_torque_nm: peak[j.index()],
+            torque_limit_nm: humanoid.torque_limit_nm(j),
+            torque_limited_share: limited_steps[j.index()] as f64 / steps.max(1) as f64,
+            clamped_frames: targets.clamped_frames(j),
+            clamped_by_deg: targets.clamped_by_rad(j).to_degrees(),
+        })
+        .collect();
+    let summary = Summary {
+        format: "imitate-execution/1",
+        frames: frames.len(),
+        frame_time_s: frame_time,
+        duration_s: (frames.len() - 1) as f64 * frame_time,
+        base,
+        balance,
+        rate_hz: 1.0 / dt,
+        steps,
+        gains,
+        height_m: motion.body.proportions.height_m,
+        mass_kg: body_mass_kg(&motion.body),
+        rms_error_deg: rms_deg(&mut motorized().flat_map(errors)),
+        max_error_deg: max_deg(&mut motorized().flat_map(errors)),
+        pelvis_tilt_rms_error_deg: rms_deg(&mut errors(Joint::Pelvis)),
+        clamped_frames: targets.frames_clamped(),
+        max_joint_gap_mm: max_joint_gap_m * 1e3,
+        fell: fell_at_s.is_some(),
+        fell_at_s,
+        joints,
+    };
+    Ok(Execution { targets, frames, summary, body: motion.body.clone() })
+}
+
+fn fallen(humanoid: &Humanoid, standing_pelvis_m: f64) -> bool {
+    let frame = humanoid.frame();
+    let pelvis = frame.position(Joint::Pelvis);
+    let trunk = frame.position(Joint::Neck) - pelvis;
+    pelvis.y < FALLEN_PELVIS_SHARE * standing_pelvis_m || trunk.angle_between(DVec3::Y) > FALLEN_LEAN_RAD
+}
+
+/// The joint that turns most from pose `a` to pose `b`, and by how much,
+/// radians.
+fn largest_turn(a: &Pose, b: &Pose) -> (Joint, f64) {
+    motorized()
+        .map(|j| (j, angle_between(a.local_rotation(j), b.local_rotation(j))))
+        .fold((Joint::Pelvis, 0.0), |most, turn| if turn.1 > most.1 { turn } else { most })
+}
+
+/// A first frame that looks like a bind pose (the T-pose many capture files
+/// start with): some joint turns more than 45° from it to the next frame,
+/// more than three times the largest turn of nine in ten later frames
+/// (measured on the real captures: 77–126° against at most 30°; the
+/// largest later turn is no yardstick, as retargeting glitches and fast
+/// kicks reach 170°). Returns that joint, its first turn and that later
+/// turn, radians.
+pub fn bind_pose_start(motion: &Motion) -> Option<(Joint, f64, f64)> {
+    let poses = &motion.poses;
+    if poses.len() < 3 {
+        return None;
+    }
+    let (joint, first) = largest_turn(&poses[0], &poses[1]);
+    let mut later: Vec<f64> = poses[1..].windows(2).map(|w| largest_turn(&w[0], &w[1]).1).collect();
+    later.sort_by(f64::total_cmp);
+    let typical = later[(later.len() * 9 / 10).min(later.len() - 1)];
+    (first > 45f64.to_radians() && first > 3.0 * typical).then_some((joint, first, typical))
+}
+
+impl Execution {
+    /// What the humanoid did, on the canonical skeleton, at the
+    /// trajectory's frames.
+    pub fn motion(&self) -> Motion {
+        let poses = self.frames.iter().map(|f| f.achieved).collect();
+        Motion { body: self.body.clone(), frame_time_s: self.targets.frame_time_s(), poses }
+    }
+
+    /// The header line of `execution.csv`.
+    pub fn csv_header(&self) -> String {
+        let mut columns: Vec<String> =
+            ["frame", "time_s", "root_x", "root_y", "root_z", "pelvis_tilt_error_deg"].map(String::from).to_vec();
+        for j in motorized() {
+            for number in numbers(j) {
+                columns.extend(["target_deg", "deg", "torque_nm"].map(|what| format!("{number}_{what}")));
+            }
+            columns.push(format!("{}_error_deg", j.name()));
+        }
+        columns.join(",") + "\n"
+    }
+
+    /// Frame `k`'s line of `execution.csv`: meters to the micrometre,
+    /// degrees to 1e-4 (the simulation's f32 resolves about 6e-5°), N·m to
+    /// the thousandth.
+    pub fn csv_row(&self, k: usize) -> String {
+        let f = &self.frames[k];
+        let (asked, root) = (self.targets.pose(k), f.achieved.root);
+        let mut line = format!(
+            "{k},{},{:.6},{:.6},{:.6},{:.4}",
+            f.time_s,
+            root.x,
+            root.y,
+            root.z,
+            f.error_rad[Joint::Pelvis.index()].to_degrees()
+        );
+        const INFALLIBLE: &str = "writing to a String cannot fail";
+        for j in motorized() {
+            let torque = f.torque[j.index()];
+            let torques: Vec<f64> = match j.kind() {
+                Kind::Hinge { axis, .. } => vec![torque.dot(axis)],
+                Kind::Ball { .. } => torque.to_array().to_vec(),
+            };
+            for ((target, reached), torque) in asked.joint(j).iter().zip(f.achieved.joint(j)).zip(torques) {
+                let (target, reached) = (target.to_degrees(), reached.to_degrees());
+                write!(line, ",{target:.4},{reached:.4},{torque:.3}").expect(INFALLIBLE);
+            }
+            write!(line, ",{:.4}", f.error_rad[j.index()].to_degrees()).expect(INFALLIBLE);
+        }
+        line + "\n"
+    }
+}
+
+/// The names of joint `j`'s joint-space numbers in `execution.csv`: a
+/// hinge's angle `<joint>`, a ball joint's rotation vector `<joint>_x`,
+/// `_y`, `_z`.
+fn numbers(j: Joint) -> Vec<String> {
+    match j.kind() {
+        Kind::Hinge { .. } => vec![j.name().to_string()],
+        Kind::Ball { .. } => ["x", "y", "z"].map(|axis| format!("{}_{axis}", j.name())).to_vec(),
+    }
+}

@@ -1,0 +1,585 @@
+//! The canonical humanoid as rigid bodies in rapier3d: one link per joint,
+//! joined by rapier's impulse joints (hinges for elbows and knees,
+//! spherical joints elsewhere) with a motor on every axis.
+//!
+//! Each link's frame is its joint's frame: at the joint, turned with it, so
+//! at rest every frame is the world's and a link's rotation relative to its
+//! parent is the joint's rotation.
+//!
+//! Why impulse joints and not rapier's multibodies (reduced coordinates):
+//! a multibody's step costs O(links × dofs²) (its mass matrix is rebuilt
+//! whole each step), about 1 ms for these 40 motors, which is 4× real time
+//! at 240 Hz; and its three-axis joints integrate angular velocity rather
+//! than keep a rotation coordinate, so their motors cannot hold a pose.
+//! Impulse joints cost O(joints) a step.
+
+use super::anthropometry::{Inertial, bone_radius_m, inertials, torque_limit_nm};
+use super::targets::{JointTarget, clamp, motorized};
+use crate::mocap::body::{Body, JOINTS, Joint, Kind};
+use crate::mocap::math::hinge_angle;
+use crate::mocap::pose::{BodyFrame, Pose};
+use glam::{DMat3, DQuat, DVec3, Quat, Vec3};
+use rapier3d::prelude::*;
+
+/// How the pelvis is held.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Base {
+    /// Fixed in place where the trajectory starts, as a humanoid on a
+    /// stand; no ground.
+    Fixed,
+    /// Free, standing on a ground plane (y = 0), where it may fall.
+    Free,
+}
+
+/// A collision shape in its link's frame.
+#[derive(Clone, Copy, Debug)]
+enum Shape {
+    Capsule {
+        a: DVec3,
+        b: DVec3,
+        radius: f64,
+    },
+    /// The foot: a box from heel to toe, ankle height tall, whose sole is
+    /// the ground plane at rest.
+    Box {
+        center: DVec3,
+        half: DVec3,
+    },
+}
+
+impl Shape {
+    fn collider(&self) -> ColliderBuilder {
+        match *self {
+            Shape::Capsule { a, b, radius } => {
+                ColliderBuilder::capsule_from_endpoints(a.as_vec3(), b.as_vec3(), radius as f32)
+            }
+            Shape::Box { center, half } => {
+                ColliderBuilder::cuboid(half.x as f32, half.y as f32, half.z as f32).translation(center.as_vec3())
+            }
+        }
+    }
+
+    /// The shape's lowest height once its link is at `position`, turned by
+    /// `rotation`.
+    fn lowest(&self, position: DVec3, rotation: DQuat) -> f64 {
+        match *self {
+            Shape::Capsule { a, b, radius } => (position + rotation * a).y.min((position + rotation * b).y) - radius,
+            Shape::Box { center, half } => (0..8)
+                .map(|corner| {
+                    let sign = |bit: usize| if corner & (1 << bit) == 0 { -1.0 } else { 1.0 };
+                    let offset = DVec3::new(sign(0) * half.x, sign(1) * half.y, sign(2) * half.z);
+                    (position + rotation * (center + offset)).y
+                })
+                .fold(f64::INFINITY, f64::min),
+        }
+    }
+}
+
+/// Each link's collision shape: a capsule along its bone as the camera
+/// model draws it (vision::shape), the feet a flat box to stand on.
+fn shapes(body: &Body) -> [Shape; JOINTS] {
+    let rest = body.forward(&Pose::rest(body));
+    Joint::ALL.map(|j| {
+        let radius = bone_radius_m(body, j);
+        let end = body.bone(j);
+        match j {
+            Joint::LeftAnkle | Joint::RightAnkle => {
+                // From the heel to the toe tip, the ankle a quarter of the
+                // foot's length in front of the heel; from the ground up to
+                // the ankle.
+                let ankle_height = rest.position(j).y;
+                let toe = end.z;
+                let heel = -toe / 3.0;
+                Shape::Box {
+                    center: DVec3::new(0.0, -0.5 * ankle_height, 0.5 * (heel + toe)),
+                    half: DVec3::new(radius, 0.5 * ankle_height, 0.5 * (toe - heel)),
+                }
+            }
+            // The rounded end stops at an end site rather than passing it.
+            _ if j.bone_child().is_none() => {
+                Shape::Capsule { a: DVec3::ZERO, b: end - end.normalize() * radius.min(end.length()), radius }
+            }
+            _ => Shape::Capsule { a: DVec3::ZERO, b: end, radius },
+        }
+    })
+}
+
+/// One joint's motors: one about a hinge's axis, three about a ball
+/// joint's (rapier's AngX, AngY, AngZ).
+#[derive(Clone, Debug)]
+struct Actuator {
+    handle: ImpulseJointHandle,
+    joint: Joint,
+    axes: &'static [JointAxis],
+}
+
+const HINGE_AXES: &[JointAxis] = &[JointAxis::AngX];
+const BALL_AXES: &[JointAxis] = &[JointAxis::AngX, JointAxis::AngY, JointAxis::AngZ];
+
+/// The simulated humanoid and its world.
+pub struct Humanoid {
+    world: PhysicsWorld,
+    links: [RigidBodyHandle; JOINTS],
+    colliders: [ColliderHandle; JOINTS],
+    /// The ground's collider, on a free base.
+    ground: Option<ColliderHandle>,
+    actuators: Vec<Actuator>,
+    /// Per joint, the most torque each of its motors may apply, N·m (0 for
+    /// the pelvis, which has none).
+    torque_limits: [f64; JOINTS],
+    inertials: [Inertial; JOINTS],
+    /// For each joint, the joints whose links it carries (itself included).
+    carried: [Vec<Joint>; JOINTS],
+    /// Each joint's place in its parent's frame.
+    offsets: [DVec3; JOINTS],
+    /// The middle of each foot's sole (left, right) in its ankle's frame.
+    soles: [DVec3; 2],
+}
+
+/// Stiffness and damping of every motor per unit of the inertia it turns.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Gains {
+    /// 1/s²: the joint's natural frequency is √kp rad/s.
+    pub kp_per_s2: f64,
+    /// 1/s: the damping ratio is kd / (2 √kp).
+    pub kd_per_s: f64,
+}
+
+impl Gains {
+    /// A natural frequency of 100 rad/s (16 Hz), critically damped.
+    pub const STANDARD: Gains = Gains { kp_per_s2: 10000.0, kd_per_s: 200.0 };
+}
+
+const GROUND: Group = Group::GROUP_2;
+const BODY: Group = Group::GROUP_1;
+const GRAVITY_M_S2: f64 = 9.81;
+/// The most the balance may tilt the body on its ankles.
+const BALANCE_MAX_RAD: f64 = 0.25;
+/// Every actuator's joint stays in the world it was put in.
+const JOINT: &str = "the humanoid's joints are never removed";
+const FEET: [Joint; 2] = [Joint::LeftAnkle, Joint::RightAnkle];
+
+impl Humanoid {
+    /// The humanoid of `body` in `pose`, every joint turning as `start`
+    /// asks, stepped every `dt_s`. On a free base the pose is lowered or
+    /// raised until its lowest point touches the ground.
+    pub fn new(body: &Body, base: Base, pose: &Pose, start: &[JointTarget; JOINTS], dt_s: f64) -> Humanoid {
+        let mut world = PhysicsWorld::new();
+        world.integration_parameters.dt = dt_s as f32;
+        world.gravity = -Vec3::Y * GRAVITY_M_S2 as f32;
+        // A chain of joints holds a heavy body up only once the solver has
+        // carried the load down the chain; rapier's one inner iteration a
+        // pass leaves a standing humanoid sagging until it falls (measured:
+        // 2 inner iterations fall within 6 s of standing waving, 4 do not).
+        world.integration_parameters.num_internal_pgs_iterations = 4;
+        let shapes = shapes(body);
+        let inertials = inertials(body);
+        let mut frame = body.forward(pose);
+        let mut ground = None;
+        if base == Base::Free {
+            let lowest = Joint::ALL
+                .iter()
+                .map(|&j| shapes[j.index()].lowest(frame.position(j), frame.rotation(j)))
+                .fold(f64::INFINITY, f64::min);
+            let lift = DVec3::Y * -lowest;
+            frame.positions.iter_mut().for_each(|p| *p += lift);
+            // The ground: a slab whose top is y = 0, far wider than any walk.
+            let slab = ColliderBuilder::cuboid(1000.0, 1.0, 1000.0).collision_groups(groups(GROUND)).friction(1.0);
+            ground = Some(world.insert(RigidBodyBuilder::fixed().translation(-Vec3::Y), slab).1);
+        }
+        let placed = Joint::ALL.map(|j| {
+            let kind = match (j, base) {
+                (Joint::Pelvis, Base::Fixed) => RigidBodyBuilder::fixed(),
+                _ => RigidBodyBuilder::dynamic(),
+            };
+            let inertial = inertials[j.index()];
+            let properties =
+                MassProperties::new(inertial.com.as_vec3(), inertial.mass_kg as f32, inertial.inertia.as_vec3());
+            // Asleep, a body would not wake for a motor's new target.
+            let rigid = kind.pose(placement(&frame, j)).additional_mass_properties(properties).can_sleep(false);
+            // Mass comes from the tables above, not from the shapes.
+            let collider = shapes[j.index()].collider().density(0.0).friction(1.0).collision_groups(groups(BODY));
+            world.insert(rigid, collider)
+        });
+        let colliders = placed.map(|(_, collider)| collider);
+        let links = placed.map(|(link, _)| link);
+
+        let mut torque_limits = [0.0; JOINTS];
+        let actuators = motorized()
+            .map(|j| {
+                let parent = j.parent().expect("only the pelvis has no parent");
+                let limit = torque_limit_nm(body, j).expect("every joint but the pelvis has a motor");
+                torque_limits[j.index()] = limit;
+                let (joint, axes) = motorized_joint(j, body.offset(j), limit);
+                let handle = world.insert_impulse_joint(links[parent.index()], links[j.index()], joint);
+                Actuator { handle, joint: j, axes }
+            })
+            .collect();
+        let carried = Joint::ALL.map(|j| Joint::ALL.into_iter().filter(|&c| carries(j, c)).collect());
+        let offsets = Joint::ALL.map(|j| body.offset(j));
+        let soles = FEET.map(|foot| match shapes[foot.index()] {
+            Shape::Box { center, half } => center - DVec3::Y * half.y,
+            Shape::Capsule { .. } => unreachable!("the feet are boxes"),
+        });
+        let mut humanoid =
+            Humanoid { world, links, colliders, ground, actuators, torque_limits, inertials, carried, offsets, soles };
+        humanoid.set_velocities(start);
+        humanoid
+    }
+
+    /// Sets every link moving as the joints' spins in `start` move it (the
+    /// pelvis still), so a trajectory starts in motion.
+    fn set_velocities(&mut self, start: &[JointTarget; JOINTS]) {
+        let frame = self.frame();
+        let mut spin = [DVec3::ZERO; JOINTS];
+        let mut linear = [DVec3::ZERO; JOINTS];
+        for j in motorized() {
+            let p = j.parent().expect("only the pelvis has no parent");
+            spin[j.index()] = spin[p.index()] + frame.rotation(p) * start[j.index()].spin;
+            linear[j.index()] = linear[p.index()] + spin[p.index()].cross(frame.position(j) - frame.position(p));
+        }
+        for j in Joint::ALL {
+            let rigid = &mut self.world.bodies[self.links[j.index()]];
+            if rigid.is_dynamic() {
+                // rapier's linear velocity is its centre of mass's.
+                let com = rigid.center_of_mass().as_dvec3() - frame.position(j);
+                let at_com = linear[j.index()] + spin[j.index()].cross(com);
+                rigid.set_linvel(at_com.as_vec3(), true);
+                rigid.set_angvel(spin[j.index()].as_vec3(), true);
+            }
+        }
+    }
+
+    fn rotation(&self, j: Joint) -> DQuat {
+        to_f64(*self.world.bodies[self.links[j.index()]].rotation())
+    }
+
+    /// The length of rapier's substeps: it splits each step into as many as
+    /// it runs solver iterations, and motor impulses are per substep.
+    fn substep_s(&self) -> f64 {
+        let p = &self.world.integration_parameters;
+        f64::from(p.dt) / p.num_solver_iterations as f64
+    }
+
+    /// Asks every motor for `targets` by the end of the next step, with
+    /// stiffness and damping of `gains` times the inertia its axis turns in
+    /// the present pose (everything the joint carries, held rigid, or what
+    /// a standing leg holds up), then takes the step.
+    ///
+    /// A ball joint's three motors act on its rotation away from the target
+    /// (rapier's joint frame on the parent side is turned to the target),
+    /// not on the rotation from rest: the coordinates rapier's motors use
+    /// (2·asin of the quaternion's components) turn at the angular velocity
+    /// only near zero; far from it the three springs push partly sideways
+    /// and, stiff, set an arm hanging at its side (100° from the T-pose)
+    /// into flutter (measured: 80–100° RMS errors on real captures).
+    pub fn step(&mut self, targets: &[JointTarget; JOINTS], gains: Gains) {
+        let dt = f64::from(self.world.integration_parameters.dt);
+        let turned = self.turned_inertia();
+        for actuator in &self.actuators {
+            let j = actuator.joint;
+            let parent = self.rotation(j.parent().expect("only the pelvis has no parent"));
+            let target = targets[j.index()];
+            let data = &mut self.world.impulse_joints.get_mut(actuator.handle, false).expect(JOINT).data;
+            // Each motor's axis in the parent's frame, and where its zero lies.
+            let (axes, zero): ([DVec3; 3], f64) = match j.kind() {
+                Kind::Hinge { axis, .. } => ([axis, DVec3::ZERO, DVec3::ZERO], hinge_angle(target.rotation, axis)),
+                Kind::Ball { .. } => {
+                    data.local_frame1.rotation = target.rotation.as_quat();
+                    ([DVec3::X, DVec3::Y, DVec3::Z].map(|a| target.rotation * a), 0.0)
+                }
+            };
+            for (&motor, along) in actuator.axes.iter().zip(axes) {
+                let world_axis = parent * along;
+                let inertia = world_axis.dot(turned[j.index()] * world_axis);
+                let rate = target.spin.dot(along);
+                // rapier's motors are implicit springs on the joint's state
+                // at the step's start: aiming a step's travel short of the
+                // target reaches it at the step's end.
+                data.set_motor(
+                    motor,
+                    (zero - dt * rate) as f32,
+                    rate as f32,
+                    (gains.kp_per_s2 * inertia) as f32,
+                    (gains.kd_per_s * inertia) as f32,
+                );
+            }
+        }
+        self.world.step();
+    }
+
+    /// Turns the ankles' `targets` so that the body tilts about its standing
+    /// feet to bring its centre of mass back over them: the ankle strategy
+    /// of human balance. The correction moves the capture point (the centre
+    /// of mass ahead by its velocity over the inverted pendulum's
+    /// frequency, √(g/h)) onto the middle of the soles touching the ground,
+    /// up to [`BALANCE_MAX_RAD`] of tilt. Nothing changes while no foot
+    /// stands.
+    pub fn balance(&self, targets: &mut [JointTarget; JOINTS]) {
+        let standing: Vec<usize> = (0..2).filter(|&k| self.stands(FEET[k])).collect();
+        if standing.is_empty() {
+            return;
+        }
+        let support = standing
+            .iter()
+            .map(|&k| {
+                let ankle = &self.world.bodies[self.links[FEET[k].index()]];
+                ankle.translation().as_dvec3() + to_f64(*ankle.rotation()) * self.soles[k]
+            })
+            .sum::<DVec3>()
+            / standing.len() as f64;
+        let (mut mass, mut moment, mut momentum) = (0.0, DVec3::ZERO, DVec3::ZERO);
+        for j in Joint::ALL {
+            let rigid = &self.world.bodies[self.links[j.index()]];
+            let m = self.inertials[j.index()].mass_kg;
+            mass += m;
+            moment += m * rigid.center_of_mass().as_dvec3();
+            momentum += m * rigid.linvel().as_dvec3();
+        }
+        let (com, velocity) = (moment / mass, momentum / mass);
+        let height = (com.y - support.y).max(0.1);
+        let capture = com + velocity / (GRAVITY_M_S2 / height).sqrt();
+        let shift = DVec3::new(support.x - capture.x, 0.0, support.z - capture.z);
+        // Turning the body by θ about the feet moves a point h above them by
+        // θ × h·Y; θ = Y × shift / h moves the centre of mass by `shift`.
+        let tilt = (DVec3::Y.cross(shift) / height).clamp_length_max(BALANCE_MAX_RAD);
+        for foot in FEET {
+            let shank = self.rotation(foot.parent().expect("only the pelvis has no parent"));
+            let target = &mut targets[foot.index()];
+            // The shank turned by `tilt` in the world over a foot that stays.
+            let turned = shank.inverse() * DQuat::from_scaled_axis(-tilt) * shank * target.rotation;
+            target.rotation = clamp(foot, turned).0;
+        }
+    }
+
+    /// The inertia tensor (world axes, about the joint) of what each
+    /// joint's motors turn: the links it carries, or, on a leg whose foot
+    /// stands on the ground, the rest of the body, which that leg holds up.
+    fn turned_inertia(&self) -> [DMat3; JOINTS] {
+        let placed = Joint::ALL.map(|j| {
+            let rigid = &self.world.bodies[self.links[j.index()]];
+            let rotation = to_f64(*rigid.rotation());
+            let position = rigid.translation().as_dvec3();
+            (position, DMat3::from_quat(rotation), position + rotation * self.inertials[j.index()].com)
+        });
+        let about = |at: DVec3, links: &mut dyn Iterator<Item = Joint>| {
+            links.fold(DMat3::ZERO, |sum, c| {
+                let (_, rotation, com) = placed[c.index()];
+                sum + self.inertials[c.index()].tensor_about(rotation, com - at)
+            })
+        };
+        let standing = FEET.map(|foot| self.stands(foot));
+        Joint::ALL.map(|j| {
+            let at = placed[j.index()].0;
+            let carried = about(at, &mut self.carried[j.index()].iter().copied());
+            let holds_up = foot_of(j).is_some_and(|foot| standing[usize::from(foot == Joint::RightAnkle)]);
+            if holds_up { about(at, &mut Joint::ALL.into_iter()) - carried } else { carried }
+        })
+    }
+
+    /// Whether `foot`'s link touches the ground.
+    fn stands(&self, foot: Joint) -> bool {
+        self.ground.is_some_and(|ground| {
+            let pair = self.world.narrow_phase.contact_pair(self.colliders[foot.index()], ground);
+            pair.is_some_and(|p| p.has_any_active_contact())
+        })
+    }
+
+    /// The torque each joint's motors applied in the last substep of the
+    /// last step (N·m, in the parent's frame; the pelvis's is zero), and
+    /// whether one of its motors was at its limit.
+    pub fn torques(&self, torque: &mut [DVec3; JOINTS], at_limit: &mut [bool; JOINTS]) {
+        let substep = self.substep_s();
+        for actuator in &self.actuators {
+            let j = actuator.joint;
+            let data = &self.world.impulse_joints.get(actuator.handle).expect(JOINT).data;
+            let most = self.torque_limits[j.index()] * substep;
+            let impulses = actuator.axes.iter().map(|&axis| data.motor(axis).map_or(0.0, |m| f64::from(m.impulse)));
+            let (mut sum, mut limited) = (DVec3::ZERO, false);
+            for (impulse, k) in impulses.zip(0..) {
+                // A hinge's motor turns about its axis; a ball joint's about
+                // the axes of its target frame.
+                let along = match j.kind() {
+                    Kind::Hinge { axis, .. } => axis,
+                    Kind::Ball { .. } => to_f64(data.local_frame1.rotation) * DVec3::AXES[k],
+                };
+                sum += along * impulse;
+                // rapier caps each impulse at the limit times the substep,
+                // in f32.
+                limited |= impulse.abs() >= most * (1.0 - 1e-5);
+            }
+            torque[j.index()] = sum / substep;
+            at_limit[j.index()] = limited;
+        }
+    }
+
+    /// How far apart the two sides of the most stretched joint are, meters:
+    /// impulse joints are held together by the solver, not by construction.
+    pub fn largest_joint_gap_m(&self) -> f64 {
+        let frame = self.frame();
+        Joint::ALL
+            .into_iter()
+            .filter_map(|j| {
+                let p = j.parent()?;
+                let expected = frame.position(p) + frame.rotation(p) * self.offsets[j.index()];
+                Some((frame.position(j) - expected).length())
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// The most torque each of joint `j`'s motors may apply, N·m.
+    pub fn torque_limit_nm(&self, j: Joint) -> f64 {
+        self.torque_limits[j.index()]
+    }
+
+    /// Where every joint is and how it is turned, in the world.
+    pub fn frame(&self) -> BodyFrame {
+        let mut positions = [DVec3::ZERO; JOINTS];
+        let mut rotations = [DQuat::IDENTITY; JOINTS];
+        for j in Joint::ALL {
+            let rigid = &self.world.bodies[self.links[j.index()]];
+            positions[j.index()] = rigid.translation().as_dvec3();
+            rotations[j.index()] = to_f64(*rigid.rotation());
+        }
+        BodyFrame { positions, rotations }
+    }
+
+    /// The pose the humanoid is in: every joint's rotation relative to its
+    /// parent, the pelvis's place and turn in the world.
+    pub fn pose(&self) -> Pose {
+        let frame = self.frame();
+        let local = Joint::ALL.map(|j| match j.parent() {
+            None => frame.rotation(j),
+            Some(p) => (frame.rotation(p).inverse() * frame.rotation(j)).normalize(),
+        });
+        Pose::from_rotations(frame.position(Joint::Pelvis), &local)
+    }
+}
+
+/// Joint `j` at `anchor` in its parent's frame, a motor on each of its axes
+/// capped at `torque_limit_nm`. A hinge stops at its limits; a ball joint's
+/// motors move their zero every step ([`Humanoid::step`]), so its limit is
+/// kept on the targets instead ([`super::targets::clamp`]).
+fn motorized_joint(j: Joint, anchor: DVec3, torque_limit_nm: f64) -> (GenericJoint, &'static [JointAxis]) {
+    let (mut joint, axes): (GenericJoint, _) = match j.kind() {
+        Kind::Hinge { axis, min_rad, max_rad } => (
+            RevoluteJointBuilder::new(axis.as_vec3()).limits([min_rad as f32, max_rad as f32]).build().into(),
+            HINGE_AXES,
+        ),
+        Kind::Ball { .. } => (SphericalJointBuilder::new().build().into(), BALL_AXES),
+    };
+    joint.set_local_anchor1(anchor.as_vec3()).set_local_anchor2(Vec3::ZERO);
+    for &axis in axes {
+        joint.set_motor_model(axis, MotorModel::ForceBased).set_motor_max_force(axis, torque_limit_nm as f32);
+    }
+    (joint, axes)
+}
+
+/// The foot at the end of the leg `j` belongs to, if it is a leg joint.
+fn foot_of(j: Joint) -> Option<Joint> {
+    use Joint::*;
+    match j {
+        LeftHip | LeftKnee | LeftAnkle => Some(LeftAnkle),
+        RightHip | RightKnee | RightAnkle => Some(RightAnkle),
+        _ => None,
+    }
+}
+
+/// Whether `ancestor`'s motors turn `joint`'s link.
+fn carries(ancestor: Joint, joint: Joint) -> bool {
+    std::iter::successors(Some(joint), |j| j.parent()).any(|j| j == ancestor)
+}
+
+fn placement(frame: &BodyFrame, j: Joint) -> rapier3d::math::Pose {
+    rapier3d::math::Pose::from_parts(frame.position(j).as_vec3(), frame.rotation(j).as_quat())
+}
+
+fn groups(member: Group) -> InteractionGroups {
+    let other = if member == GROUND { BODY } else { GROUND };
+    InteractionGroups::new(member, other, InteractionTestMode::And)
+}
+
+fn to_f64(q: Quat) -> DQuat {
+    q.as_dquat().normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mocap::math::log_map;
+
+    const DT: f64 = 1.0 / 240.0;
+
+    fn rest_humanoid(base: Base) -> (Body, Humanoid) {
+        let body = Body::standard();
+        let humanoid = Humanoid::new(&body, base, &Pose::rest(&body), &[JointTarget::REST; JOINTS], DT);
+        (body, humanoid)
+    }
+
+    /// Weight times horizontal lever of everything `j` carries, in the
+    /// rest pose, N·m.
+    fn static_load_nm(body: &Body, j: Joint) -> f64 {
+        let frame = body.forward(&Pose::rest(body));
+        let at = frame.position(j);
+        let inertials = inertials(body);
+        Joint::ALL
+            .into_iter()
+            .filter(|&c| carries(j, c))
+            .map(|c| {
+                let i = inertials[c.index()];
+                let lever = frame.position(c) + i.com - at;
+                i.mass_kg * GRAVITY_M_S2 * DVec3::new(lever.x, 0.0, lever.z).length()
+            })
+            .sum()
+    }
+
+    #[test]
+    fn holding_the_arms_out_takes_the_torque_of_their_weight_about_each_joint() {
+        let (body, mut humanoid) = rest_humanoid(Base::Fixed);
+        let (mut torque, mut limited) = ([DVec3::ZERO; JOINTS], [false; JOINTS]);
+        for _ in 0..240 {
+            humanoid.step(&[JointTarget::REST; JOINTS], Gains::STANDARD);
+        }
+        humanoid.torques(&mut torque, &mut limited);
+        // The T-pose's elbow hinges turn about the vertical: their joints, not
+        // their motors, hold the forearms up.
+        assert!(torque[Joint::LeftElbow.index()].length() < 0.01, "{}", torque[Joint::LeftElbow.index()]);
+        for j in [Joint::LeftShoulder, Joint::RightShoulder, Joint::LeftWrist] {
+            let expected = static_load_nm(&body, j);
+            let got = torque[j.index()];
+            assert!((got.length() - expected).abs() < 0.03 * expected, "{j:?}: {got} against {expected:.3} N·m");
+            // Holding up an arm along ±X is a torque about Z.
+            assert!(got.normalize().z.abs() > 0.99, "{j:?}: {got}");
+            assert!(!limited[j.index()]);
+        }
+        // Without a feedforward term a motor holds its load by sagging until
+        // its spring pushes back, by about the load over kp times the inertia
+        // it turns: 0.1–0.5° here.
+        let pose = humanoid.pose();
+        let worst = motorized().map(|j| log_map(pose.local_rotation(j)).length()).fold(0.0, f64::max);
+        assert!(worst < 1f64.to_radians(), "the rest pose held within {:.3}°", worst.to_degrees());
+    }
+
+    #[test]
+    fn a_humanoid_standing_at_rest_on_the_ground_stays_up() {
+        let (body, mut humanoid) = rest_humanoid(Base::Free);
+        let start = humanoid.frame().position(Joint::Pelvis);
+        // Lowered onto the ground: the soles at y = 0.
+        assert!((start.y - body.pelvis_height()).abs() < 1e-6, "{start}");
+        for _ in 0..(5.0 / DT) as usize {
+            let mut targets = [JointTarget::REST; JOINTS];
+            humanoid.balance(&mut targets);
+            humanoid.step(&targets, Gains::STANDARD);
+        }
+        let frame = humanoid.frame();
+        let end = frame.position(Joint::Pelvis);
+        // The feet press 4 mm into the ground (rapier's contacts are soft).
+        assert!((end.y - start.y).abs() < 0.01, "the pelvis went from {start} to {end} in 5 s");
+        let lean = (frame.position(Joint::Neck) - end).angle_between(DVec3::Y);
+        // Upright: it falls at 60°.
+        assert!(lean < 5f64.to_radians(), "the trunk leans {:.1}°", lean.to_degrees());
+        assert!(FEET.iter().all(|&f| humanoid.stands(f)), "both feet on the ground");
+        assert!(humanoid.largest_joint_gap_m() < 1e-3);
+    }
+}

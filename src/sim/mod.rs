@@ -1,0 +1,8 @@
+//! The simulated humanoid (GUIDE §4.6): the canonical body as rigid bodies
+//! in rapier3d, with anthropometric masses and a motor on every joint, and
+//! the playing of a trajectory on it (`imitate execute`).
+
+pub mod anthropometry;
+pub mod execute;
+pub mod humanoid;
+pub mod targets;

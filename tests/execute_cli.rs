@@ -1,0 +1,284 @@
+//! `imitate execute`: trajectories played on the simulated humanoid. The
+//! paper's four activities followed on a fixed base, every real capture
+//! played, the files agreeing with each other, the same bytes every time,
+//! falls reported, joint limits counted, and bad input refused with
+//! nothing written.
+
+mod common;
+
+use common::{imitate, real_bvh_files};
+use imitate::mocap::body::{Body, Joint};
+use imitate::mocap::bvh::{read_bvh, write_bvh};
+use imitate::mocap::pose::{Motion, Pose};
+use imitate::mocap::retarget::{RetargetOptions, Retargeter};
+use serde_json::Value;
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+fn stderr_of(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn execute(input: &Path, output: &Path, extra: &[&str]) -> Output {
+    imitate().arg("execute").arg(input).arg("-o").arg(output).args(extra).output().unwrap()
+}
+
+/// Runs `execute` and reads its summary.json.
+fn executed(input: &Path, output: &Path, extra: &[&str]) -> Value {
+    let out = execute(input, output, extra);
+    assert!(out.status.success(), "{}: {}", input.display(), stderr_of(&out));
+    serde_json::from_slice(&fs::read(output.join("summary.json")).unwrap()).unwrap()
+}
+
+/// `imitate synth` takes of `activities` at `speed`, in `dir`.
+fn synth(dir: &Path, activities: &str, speed: &str) -> PathBuf {
+    let out = imitate()
+        .args(["-q", "synth", "--activities", activities, "--speed", speed, "--seed", "3", "-o"])
+        .arg(dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    dir.to_path_buf()
+}
+
+/// execution.csv as its header and rows of numbers.
+fn table(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = fs::read_to_string(dir.join("execution.csv")).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    (header, rows)
+}
+
+fn column(header: &[String], name: &str) -> usize {
+    header.iter().position(|c| c == name).unwrap_or_else(|| panic!("no column {name}"))
+}
+
+fn read_motion(path: &Path) -> Motion {
+    let bvh = read_bvh(path).unwrap();
+    Retargeter::new(&bvh, &RetargetOptions::default()).unwrap().retarget(&bvh)
+}
+
+fn number(summary: &Value, key: &str) -> f64 {
+    summary[key].as_f64().unwrap_or_else(|| panic!("{key} in {summary}"))
+}
+
+#[test]
+fn the_four_paper_activities_are_followed_within_three_degrees_on_a_fixed_base() {
+    let dir = tempfile::tempdir().unwrap();
+    let activities = ["circles", "wave-h", "wave-v", "punch"];
+    for speed in ["1", "4"] {
+        let takes = synth(&dir.path().join(format!("takes-{speed}")), &activities.join(","), speed);
+        for activity in activities {
+            let run = dir.path().join(format!("run-{speed}-{activity}"));
+            let s = executed(&takes.join(format!("{activity}.bvh")), &run, &["--fixed-base", "-q"]);
+            let rms = number(&s, "rms_error_deg");
+            eprintln!("{activity} at {speed}x: {rms:.2}° RMS, {:.2}° at worst", number(&s, "max_error_deg"));
+            if speed == "1" {
+                assert!(rms <= 3.0, "{activity} at 1x: {rms:.2}° RMS");
+            }
+            assert_eq!(s["base"], "fixed");
+            assert_eq!(s["fell"], false);
+            assert_eq!(s["rate_hz"], 240.0);
+            // The joints hold together: rapier's joints are kept by its solver.
+            assert!(number(&s, "max_joint_gap_mm") < 1.0, "{s}");
+        }
+    }
+}
+
+#[test]
+fn the_summary_is_the_table_and_executed_bvh_is_what_the_table_says_the_humanoid_did() {
+    let dir = tempfile::tempdir().unwrap();
+    let takes = synth(&dir.path().join("takes"), "punch", "2");
+    let run = dir.path().join("run");
+    let s = executed(&takes.join("punch.bvh"), &run, &["--fixed-base", "-q"]);
+    let (header, rows) = table(&run);
+    let source = read_motion(&takes.join("punch.bvh"));
+    assert_eq!(rows.len(), source.poses.len());
+    assert_eq!(number(&s, "frames") as usize, rows.len());
+
+    // The overall RMS is over every actuated joint's error column, from the
+    // second frame (the first is where the humanoid was put).
+    let errors: Vec<usize> =
+        Joint::ALL.iter().skip(1).map(|j| column(&header, &format!("{}_error_deg", j.name()))).collect();
+    let squares: Vec<f64> = rows[1..].iter().flat_map(|r| errors.iter().map(move |&c| r[c] * r[c])).collect();
+    let rms = (squares.iter().sum::<f64>() / squares.len() as f64).sqrt();
+    assert!((rms - number(&s, "rms_error_deg")).abs() < 1e-3, "{rms} against {}", s["rms_error_deg"]);
+    let elbow = s["joints"].as_array().unwrap().iter().find(|j| j["joint"] == "right_elbow").unwrap();
+    let torque = column(&header, "right_elbow_torque_nm");
+    let peak = rows.iter().map(|r| r[torque].abs()).fold(0.0, f64::max);
+    // The summary's peak is over every physics step, the table's over frames.
+    assert!(number(elbow, "peak_torque_nm") >= peak - 1e-3 && peak > 0.0, "{elbow} against {peak}");
+
+    // executed.bvh, read back, holds the achieved angles of the table: a
+    // ball joint's three numbers are its rotation vector, a hinge's its angle.
+    let done = read_motion(&run.join("executed.bvh"));
+    assert_eq!(done.poses.len(), rows.len());
+    for (k, (pose, row)) in done.poses.iter().zip(&rows).enumerate() {
+        for (j, index, name) in [(Joint::RightShoulder, 1, "right_shoulder_y"), (Joint::RightElbow, 0, "right_elbow")] {
+            let angle = pose.joint(j)[index].to_degrees();
+            let listed = row[column(&header, &format!("{name}_deg"))];
+            assert!((angle - listed).abs() < 2e-3, "frame {k} {name}: {angle} in the BVH, {listed} in the table");
+        }
+        // The targets are the trajectory's angles (inside every limit here).
+        let asked = source.poses[k].joint(Joint::RightElbow)[0].to_degrees();
+        assert!((asked - row[column(&header, "right_elbow_target_deg")]).abs() < 1e-3, "frame {k}");
+    }
+}
+
+#[test]
+fn the_same_inputs_give_the_same_bytes_on_either_base() {
+    let dir = tempfile::tempdir().unwrap();
+    let takes = synth(&dir.path().join("takes"), "wave-h", "1");
+    for base in [&["--fixed-base"][..], &[][..]] {
+        let runs: Vec<PathBuf> = (0..2).map(|k| dir.path().join(format!("run{k}-{}", base.len()))).collect();
+        for run in &runs {
+            executed(&takes.join("wave-h.bvh"), run, &[base, &["-q"]].concat());
+        }
+        for file in ["executed.bvh", "execution.csv", "summary.json"] {
+            assert!(fs::read(runs[0].join(file)).unwrap() == fs::read(runs[1].join(file)).unwrap(), "{file} differs");
+        }
+    }
+}
+
+#[test]
+fn standing_on_the_ground_a_waving_humanoid_stays_up_and_one_bent_double_falls_and_says_when() {
+    let dir = tempfile::tempdir().unwrap();
+    let takes = synth(&dir.path().join("takes"), "wave-v", "1");
+    let s = executed(&takes.join("wave-v.bvh"), &dir.path().join("up"), &["-q"]);
+    assert_eq!((s["base"].as_str(), s["balance"].as_bool()), (Some("free"), Some(true)));
+    assert_eq!(s["fell"], false, "{s}");
+    assert!(s["fell_at_s"].is_null());
+    assert!(number(&s, "rms_error_deg") <= 3.0, "{s}");
+
+    // Bent forward 80° at the hips within a second: the centre of mass far
+    // beyond the toes.
+    let body = Body::standard();
+    let poses: Vec<Pose> = (0..60)
+        .map(|k| {
+            let mut p = Pose::rest(&body);
+            let bend = (k as f64 / 30.0).min(1.0) * 80f64.to_radians();
+            for hip in [Joint::LeftHip, Joint::RightHip] {
+                p.x[hip.dof_offset()] = bend;
+            }
+            p
+        })
+        .collect();
+    let bending = dir.path().join("bend.bvh");
+    let motion = Motion { body, frame_time_s: 1.0 / 30.0, poses };
+    write_bvh(&motion.to_bvh(), &mut fs::File::create(&bending).unwrap()).unwrap();
+    let run = dir.path().join("down");
+    let s = executed(&bending, &run, &["-q"]);
+    assert_eq!(s["fell"], true, "{s}");
+    let at = number(&s, "fell_at_s");
+    assert!(at > 0.0 && at < number(&s, "duration_s"), "{s}");
+    // By the end the pelvis is far below standing height.
+    let (header, rows) = table(&run);
+    let last = rows.last().unwrap()[column(&header, "root_y")];
+    assert!(last < 0.7 * Body::standard().pelvis_height(), "the pelvis ends at {last} m");
+}
+
+#[test]
+fn angles_beyond_a_joint_limit_are_clamped_and_counted_in_the_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let body = Body::standard();
+    // The left elbow swings to 170° (its limit is 150°) on frames 10–19.
+    let poses: Vec<Pose> = (0..30)
+        .map(|k| {
+            let mut p = Pose::rest(&body);
+            p.x[Joint::LeftElbow.dof_offset()] = if (10..20).contains(&k) { 170f64.to_radians() } else { 1.0 };
+            p
+        })
+        .collect();
+    let input = dir.path().join("over.bvh");
+    write_bvh(&Motion { body, frame_time_s: 1.0 / 30.0, poses }.to_bvh(), &mut fs::File::create(&input).unwrap())
+        .unwrap();
+    let run = dir.path().join("run");
+    let s = executed(&input, &run, &["--fixed-base", "-q"]);
+    assert_eq!(s["clamped_frames"], 10, "{s}");
+    let elbow = s["joints"].as_array().unwrap().iter().find(|j| j["joint"] == "left_elbow").unwrap();
+    assert_eq!(elbow["clamped_frames"], 10);
+    assert!((number(elbow, "clamped_by_deg") - 20.0).abs() < 1e-3, "{elbow}");
+    let (header, rows) = table(&run);
+    let target = column(&header, "left_elbow_target_deg");
+    assert!((rows[15][target] - 150.0).abs() < 1e-3 && (rows[5][target] - 1f64.to_degrees()).abs() < 1e-3);
+    let reached = column(&header, "left_elbow_deg");
+    assert!(rows.iter().all(|r| r[reached] <= 150.1), "the hinge stops at its limit");
+}
+
+#[test]
+fn every_real_capture_plays_on_a_fixed_base_within_five_degrees_and_bind_poses_are_flagged() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut errors = Vec::new();
+    for path in real_bvh_files() {
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let probe = execute(&path, &dir.path().join(format!("{name}-probe")), &["--fixed-base"]);
+        assert!(probe.status.success(), "{name}: {}", stderr_of(&probe));
+        let flagged = stderr_of(&probe).contains("a bind pose? --skip 1 leaves it out");
+        // boxing starts in a T-pose and turns 110° in its first frame;
+        // wave_hello starts in motion.
+        match name.as_str() {
+            "boxing" => assert!(flagged, "{name}"),
+            "wave_hello" => assert!(!flagged, "{name}"),
+            _ => {}
+        }
+        let skip = if flagged { "1" } else { "0" };
+        let s = executed(&path, &dir.path().join(&name), &["--fixed-base", "--skip", skip, "-q"]);
+        assert_eq!(s["skipped_frames"].as_u64(), Some(u64::from(flagged)));
+        let rms = number(&s, "rms_error_deg");
+        eprintln!("{name:22} skip {skip}: {rms:.2}° RMS, {:.1}° at worst", number(&s, "max_error_deg"));
+        assert!(rms <= 5.0, "{name}: {rms:.2}° RMS");
+        errors.push(rms);
+    }
+    if !errors.is_empty() {
+        errors.sort_by(f64::total_cmp);
+        let median = errors[errors.len() / 2];
+        assert!(median <= 1.0, "median {median:.2}° RMS over the real captures");
+    }
+}
+
+#[test]
+fn bad_input_is_one_clear_error_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let takes = synth(&dir.path().join("takes"), "punch", "1");
+    let good = takes.join("punch.bvh");
+    let text = fs::read_to_string(&good).unwrap();
+    let (head, motion) = text.split_once("MOTION\n").unwrap();
+    let empty = dir.path().join("empty.bvh");
+    fs::write(&empty, format!("{head}MOTION\nFrames: 0\nFrame Time: 0.033333\n")).unwrap();
+    let nan = dir.path().join("nan.bvh");
+    let mut lines: Vec<String> = motion.lines().map(String::from).collect();
+    lines[4] =
+        lines[4].split(' ').enumerate().map(|(i, v)| if i == 10 { "nan" } else { v }).collect::<Vec<_>>().join(" ");
+    fs::write(&nan, format!("{head}MOTION\n{}\n", lines.join("\n"))).unwrap();
+    let missing = dir.path().join("missing.bvh");
+    let used = dir.path().join("used");
+    fs::create_dir(&used).unwrap();
+    fs::write(used.join("keep.txt"), "mine").unwrap();
+
+    let out = dir.path().join("out");
+    let cases: [(&Path, &Path, &[&str], i32, &str); 11] = [
+        (&good, &out, &["--gains", "0,200"], 2, "--gains 0,200: the stiffness gain must be a positive number"),
+        (&good, &out, &["--gains", "-5,200"], 2, "--gains -5,200: the stiffness gain must be a positive number"),
+        (&good, &out, &["--gains", "100,0"], 2, "--gains 100,0: the damping gain must be a positive number"),
+        (&good, &out, &["--gains", "stiff"], 2, "--gains stiff: expected KP,KD"),
+        (&good, &out, &["--rate", "0"], 2, "--rate 0: the physics rate must be"),
+        (&good, &out, &["--rate", "-240"], 2, "--rate -240: the physics rate must be"),
+        (&good, &out, &["--skip", "100000"], 2, "--skip 100000: "),
+        (&empty, &out, &[], 1, "empty.bvh: the file has no frames"),
+        (&nan, &out, &[], 1, "nan.bvh:"),
+        (&missing, &out, &[], 1, "missing.bvh"),
+        (&good, &used, &[], 1, "exists and is not empty"),
+    ];
+    for (input, output, extra, code, expected) in cases {
+        let result = execute(input, output, extra);
+        let stderr = stderr_of(&result);
+        assert_eq!(result.status.code(), Some(code), "{extra:?}: {stderr}");
+        assert!(stderr.contains(expected), "{extra:?}: {stderr}");
+        assert_eq!(stderr.lines().filter(|l| l.starts_with("imitate: error")).count(), 1, "{stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+    assert!(!out.exists(), "a refused run writes nothing");
+    assert_eq!(fs::read_dir(&used).unwrap().count(), 1, "the used folder is left alone");
+}
