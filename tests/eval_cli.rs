@@ -150,6 +150,13 @@ fn the_demo_tracks_the_shipped_vocabulary_and_prints_its_report_and_headline_num
     // The shipped vocabulary follows its own activities well.
     assert!(ub < 40.0, "upper body {ub} mm");
     assert!(metrics["recognition_accuracy_settled"].as_f64().unwrap() > 0.8);
+    // The humanoid plays the virtual trajectory standing, and says how well.
+    let execution = json(&dir.join("demo/humanoid/summary.json"));
+    assert_eq!(execution["input"], "demo/run/trajectory.bvh");
+    let rms = execution["rms_error_deg"].as_f64().unwrap();
+    assert!(said.contains(&format!("joints within {rms:.2}° RMS")), "{said}");
+    assert!(rms <= 3.0, "the humanoid follows within {rms}° RMS");
+    assert!(dir.join("demo/humanoid/executed.bvh").is_file());
     // A second demo replaces the first; another folder is never replaced.
     ok(demo());
     fs::create_dir(dir.join("mine")).unwrap();

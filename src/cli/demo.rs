@@ -15,12 +15,14 @@ const MARKER: &str = "demo.json";
 /// Run the main job on what ships with the program: render a person doing
 /// hand circles, horizontal waving and vertical waving (held-out synthetic
 /// motion, front camera, 160×120, 15 fps), track them with the shipped
-/// vocabulary, and write a report. Ends by printing where the report is and
-/// its three headline numbers.
+/// vocabulary, write a report, and play the virtual trajectory on the
+/// simulated humanoid standing on the ground. Ends by printing where the
+/// report is, its three headline numbers and how the humanoid followed.
 ///
 /// Writes DIR/motion (the motion), DIR/video (frames and truth), DIR/run
-/// (the tracking run) and DIR/report/index.html; a folder a previous demo
-/// wrote is replaced, any other that holds something is refused.
+/// (the tracking run), DIR/report/index.html and DIR/humanoid (the
+/// execution); a folder a previous demo wrote is replaced, any other that
+/// holds something is refused.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Where to put everything.
@@ -64,6 +66,7 @@ fn demo(args: &Args, global: Global) -> anyhow::Result<Outcome> {
     let vocab = dir.join("default.vocab");
     std::fs::write(&vocab, SHIPPED_VOCAB).with_context(|| format!("{}: cannot write", vocab.display()))?;
     let (motion, video, run, report) = (dir.join("motion"), dir.join("video"), dir.join("run"), dir.join("report"));
+    let humanoid = dir.join("humanoid");
     let seed = args.seed.to_string();
 
     step("synth: hand circles, horizontal waving, vertical waving");
@@ -109,24 +112,35 @@ fn demo(args: &Args, global: Global) -> anyhow::Result<Outcome> {
     let truth = video.join("truth.csv");
     invoke(&["report", &arg(&run), "--truth", &arg(&truth), "-o", &arg(&report)])?;
     bar.inc(1);
+    step("execute: the virtual trajectory on the humanoid");
+    invoke(&["execute", &arg(&run.join("trajectory.bvh")), "-o", &arg(&humanoid)])?;
+    bar.inc(1);
     bar.finish_and_clear();
 
     let metrics: serde_json::Value = serde_json::from_slice(&std::fs::read(report.join("metrics.json"))?)?;
     let number = |key: &str| metrics[key].as_f64().unwrap_or(f64::NAN);
+    let execution: serde_json::Value = serde_json::from_slice(&std::fs::read(humanoid.join("summary.json"))?)?;
+    let stood = match execution["fell_at_s"].as_f64() {
+        Some(t) => format!("fell at {t:.1} s"),
+        None => "stayed up".to_string(),
+    };
     let frames = metrics["frames"].as_u64().unwrap_or(0);
     note(
         global,
         &format!(
             "demo: {frames} frames tracked with {} primitives × {} particles in {:.0} s\n\
              upper-body error {:.1} mm (root-relative), activity recognized {:.1}% of frames (outside 0.5 s of a switch), hands {:.1} mm\n\
-             report: {}",
+             report: {}\n\
+             humanoid: played the virtual trajectory standing on the ground, joints within {:.2}° RMS, {stood}: {}",
             imitate::vocab::vocabulary::Vocabulary::load(&vocab)?.primitives().len(),
             args.particles,
             started.elapsed().as_secs_f64(),
             number("upper_body_mm"),
             100.0 * number("recognition_accuracy_settled"),
             number("hand_mm"),
-            report.join("index.html").display()
+            report.join("index.html").display(),
+            execution["rms_error_deg"].as_f64().unwrap_or(f64::NAN),
+            humanoid.join("executed.bvh").display()
         ),
     );
     Ok(Outcome::Success)
