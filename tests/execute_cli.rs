@@ -180,6 +180,40 @@ fn standing_on_the_ground_a_waving_humanoid_stays_up_and_one_bent_double_falls_a
 }
 
 #[test]
+fn on_the_ground_feet_pointing_toe_down_at_the_start_are_laid_flat_and_counted() {
+    // Standing still with both ankles turned 20° toe-down: the captured
+    // person stood flat; the canonical body would stand on its toes.
+    let dir = tempfile::tempdir().unwrap();
+    let body = Body::standard();
+    let poses: Vec<Pose> = (0..90)
+        .map(|_| {
+            let mut p = Pose::rest(&body);
+            for ankle in [Joint::LeftAnkle, Joint::RightAnkle] {
+                p.x[ankle.dof_offset()] = 20f64.to_radians();
+            }
+            p
+        })
+        .collect();
+    let input = dir.path().join("toes.bvh");
+    write_bvh(&Motion { body, frame_time_s: 1.0 / 30.0, poses }.to_bvh(), &mut fs::File::create(&input).unwrap())
+        .unwrap();
+    let s = executed(&input, &dir.path().join("ground"), &["-q"]);
+    let levelled: Vec<f64> = s["feet_levelled_deg"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    assert!(levelled.iter().all(|d| (d - 20.0).abs() < 1e-6), "{levelled:?}");
+    assert_eq!(s["fell"], false, "{s}");
+    // The soles stay flat: what the humanoid did, read back.
+    let done = read_motion(&dir.path().join("ground/executed.bvh"));
+    let last = done.body.forward(done.poses.last().unwrap());
+    for ankle in [Joint::LeftAnkle, Joint::RightAnkle] {
+        let tilt = (last.rotation(ankle) * glam::DVec3::Y).angle_between(glam::DVec3::Y).to_degrees();
+        assert!(tilt < 3.0, "{ankle:?}'s sole tilts {tilt:.1}°");
+    }
+    // On a stand there is no floor to lay them on.
+    let s = executed(&input, &dir.path().join("stand"), &["--fixed-base", "-q"]);
+    assert_eq!(s["feet_levelled_deg"], serde_json::json!([0.0, 0.0]));
+}
+
+#[test]
 fn angles_beyond_a_joint_limit_are_clamped_and_counted_in_the_summary() {
     let dir = tempfile::tempdir().unwrap();
     let body = Body::standard();

@@ -5,11 +5,11 @@
 use super::anthropometry::body_mass_kg;
 use super::humanoid::{Base, Gains, Humanoid};
 use super::targets::{JointTarget, Targets, TargetsError, motorized};
-use crate::fsutil::rounded;
+use crate::fsutil::{round6, rounded};
 use crate::mocap::body::{JOINTS, Joint, Kind};
 use crate::mocap::math::{angle_between, exp_map};
 use crate::mocap::pose::{Motion, Pose};
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 use std::fmt::Write;
 
 /// How to execute a trajectory; [`ExecuteParams::check`] validates it.
@@ -120,6 +120,9 @@ pub struct Summary {
     pub pelvis_tilt_rms_error_deg: f64,
     /// Frames on which some joint lay beyond its limits.
     pub clamped_frames: usize,
+    /// On a free base, how far each foot (left, right) was turned to stand
+    /// flat at the start (0 where it was not), to six decimals.
+    pub feet_levelled_deg: [f64; 2],
     /// The widest a joint came apart at any frame, mm (rapier's impulse
     /// joints hold by the solver, so not exactly zero).
     #[serde(serialize_with = "rounded")]
@@ -167,6 +170,11 @@ pub fn execute(
 ) -> Result<Execution, TargetsError> {
     let ExecuteParams { base, balance, gains, rate_hz } = params.0;
     let balance = balance && base == Base::Free;
+    let (levelled, feet_levelled_rad) = match base {
+        Base::Free => level_feet(motion),
+        Base::Fixed => (motion.clone(), [0.0; 2]),
+    };
+    let motion = &levelled;
     let targets = Targets::new(motion)?;
     let frame_time = targets.frame_time_s();
     let steps_per_frame = ((rate_hz * frame_time) - 1e-9).ceil().max(1.0) as usize;
@@ -251,12 +259,52 @@ pub fn execute(
         max_error_deg: max_deg(&mut motorized().flat_map(errors)),
         pelvis_tilt_rms_error_deg: rms_deg(&mut errors(Joint::Pelvis)),
         clamped_frames: targets.frames_clamped(),
+        feet_levelled_deg: feet_levelled_rad.map(|r| round6(r.to_degrees())),
         max_joint_gap_mm: max_joint_gap_m * 1e3,
         fell: fell_at_s.is_some(),
         fell_at_s,
         joints,
     };
     Ok(Execution { targets, frames, summary, body: motion.body.clone() })
+}
+
+/// A foot stands at the start when its ankle is within this of the lower
+/// ankle's height and its sole is tilted less than [`LEVEL_MAX_RAD`].
+const STANDING_FOOT_M: f64 = 0.05;
+const LEVEL_MAX_RAD: f64 = std::f64::consts::FRAC_PI_3;
+
+/// `motion` with each foot that stands at the start turned, for the whole
+/// take, by the constant rotation that lays its sole flat on the floor in
+/// the first frame, and by how much each was turned (left, right;
+/// radians). A captured foot runs from the ankle to the ball of the foot,
+/// steeper than the canonical foot's ankle to toe tip, so a retargeted
+/// person standing flat stands on the canonical body's toes (15–30° on the
+/// real captures). A foot higher than the other, or tilted further (a
+/// retargeting failure, not a stance), is left alone.
+fn level_feet(motion: &Motion) -> (Motion, [f64; 2]) {
+    let mut out = motion.clone();
+    let mut turned = [0.0; 2];
+    let Some(first) = motion.poses.first() else { return (out, turned) };
+    let frame = motion.body.forward(first);
+    let feet = [Joint::LeftAnkle, Joint::RightAnkle];
+    let lower = feet.iter().map(|&f| frame.position(f).y).fold(f64::INFINITY, f64::min);
+    for (k, foot) in feet.into_iter().enumerate() {
+        let world = frame.rotation(foot);
+        let sole = world * DVec3::Y;
+        let tilt = sole.angle_between(DVec3::Y);
+        if frame.position(foot).y > lower + STANDING_FOOT_M || tilt > LEVEL_MAX_RAD {
+            continue;
+        }
+        // In the foot's own frame, so it rides along with the ankle.
+        let correction = world.inverse() * DQuat::from_rotation_arc(sole, DVec3::Y) * world;
+        for pose in &mut out.poses {
+            let mut local = Joint::ALL.map(|j| pose.local_rotation(j));
+            local[foot.index()] *= correction;
+            *pose = Pose::from_rotations(pose.root, &local);
+        }
+        turned[k] = tilt;
+    }
+    (out, turned)
 }
 
 fn fallen(humanoid: &Humanoid, standing_pelvis_m: f64) -> bool {
