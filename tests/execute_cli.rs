@@ -7,6 +7,7 @@
 mod common;
 
 use common::{imitate, real_bvh_files};
+use glam::DVec3;
 use imitate::mocap::body::{Body, Joint};
 use imitate::mocap::bvh::{read_bvh, write_bvh};
 use imitate::mocap::pose::{Motion, Pose};
@@ -58,6 +59,22 @@ fn column(header: &[String], name: &str) -> usize {
 fn read_motion(path: &Path) -> Motion {
     let bvh = read_bvh(path).unwrap();
     Retargeter::new(&bvh, &RetargetOptions::default()).unwrap().retarget(&bvh)
+}
+
+/// Writes `path`: a canonical take of `frames` frames at 30 Hz, each the
+/// rest pose as `shape` (given the frame) sets its joint-space numbers.
+fn write_take(path: &Path, frames: usize, shape: impl Fn(usize, &mut [f64])) -> PathBuf {
+    let body = Body::standard();
+    let poses: Vec<Pose> = (0..frames)
+        .map(|k| {
+            let mut p = Pose::rest(&body);
+            shape(k, &mut p.x);
+            p
+        })
+        .collect();
+    write_bvh(&Motion { body, frame_time_s: 1.0 / 30.0, poses }.to_bvh(), &mut fs::File::create(path).unwrap())
+        .unwrap();
+    path.to_path_buf()
 }
 
 fn number(summary: &Value, key: &str) -> f64 {
@@ -154,20 +171,11 @@ fn standing_on_the_ground_a_waving_humanoid_stays_up_and_one_bent_double_falls_a
 
     // Bent forward 80° at the hips within a second: the centre of mass far
     // beyond the toes.
-    let body = Body::standard();
-    let poses: Vec<Pose> = (0..60)
-        .map(|k| {
-            let mut p = Pose::rest(&body);
-            let bend = (k as f64 / 30.0).min(1.0) * 80f64.to_radians();
-            for hip in [Joint::LeftHip, Joint::RightHip] {
-                p.x[hip.dof_offset()] = bend;
-            }
-            p
-        })
-        .collect();
-    let bending = dir.path().join("bend.bvh");
-    let motion = Motion { body, frame_time_s: 1.0 / 30.0, poses };
-    write_bvh(&motion.to_bvh(), &mut fs::File::create(&bending).unwrap()).unwrap();
+    let bending = write_take(&dir.path().join("bend.bvh"), 60, |k, x| {
+        for hip in [Joint::LeftHip, Joint::RightHip] {
+            x[hip.dof_offset()] = (k as f64 / 30.0).min(1.0) * 80f64.to_radians();
+        }
+    });
     let run = dir.path().join("down");
     let s = executed(&bending, &run, &["-q"]);
     assert_eq!(s["fell"], true, "{s}");
@@ -184,19 +192,11 @@ fn on_the_ground_feet_pointing_toe_down_at_the_start_are_laid_flat_and_counted()
     // Standing still with both ankles turned 20° toe-down: the captured
     // person stood flat; the canonical body would stand on its toes.
     let dir = tempfile::tempdir().unwrap();
-    let body = Body::standard();
-    let poses: Vec<Pose> = (0..90)
-        .map(|_| {
-            let mut p = Pose::rest(&body);
-            for ankle in [Joint::LeftAnkle, Joint::RightAnkle] {
-                p.x[ankle.dof_offset()] = 20f64.to_radians();
-            }
-            p
-        })
-        .collect();
-    let input = dir.path().join("toes.bvh");
-    write_bvh(&Motion { body, frame_time_s: 1.0 / 30.0, poses }.to_bvh(), &mut fs::File::create(&input).unwrap())
-        .unwrap();
+    let input = write_take(&dir.path().join("toes.bvh"), 90, |_, x| {
+        for ankle in [Joint::LeftAnkle, Joint::RightAnkle] {
+            x[ankle.dof_offset()] = 20f64.to_radians();
+        }
+    });
     let s = executed(&input, &dir.path().join("ground"), &["-q"]);
     let levelled: Vec<f64> = s["feet_levelled_deg"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
     assert!(levelled.iter().all(|d| (d - 20.0).abs() < 1e-6), "{levelled:?}");
@@ -205,7 +205,7 @@ fn on_the_ground_feet_pointing_toe_down_at_the_start_are_laid_flat_and_counted()
     let done = read_motion(&dir.path().join("ground/executed.bvh"));
     let last = done.body.forward(done.poses.last().unwrap());
     for ankle in [Joint::LeftAnkle, Joint::RightAnkle] {
-        let tilt = (last.rotation(ankle) * glam::DVec3::Y).angle_between(glam::DVec3::Y).to_degrees();
+        let tilt = (last.rotation(ankle) * DVec3::Y).angle_between(DVec3::Y).to_degrees();
         assert!(tilt < 3.0, "{ankle:?}'s sole tilts {tilt:.1}°");
     }
     // On a stand there is no floor to lay them on.
@@ -216,18 +216,10 @@ fn on_the_ground_feet_pointing_toe_down_at_the_start_are_laid_flat_and_counted()
 #[test]
 fn angles_beyond_a_joint_limit_are_clamped_and_counted_in_the_summary() {
     let dir = tempfile::tempdir().unwrap();
-    let body = Body::standard();
     // The left elbow swings to 170° (its limit is 150°) on frames 10–19.
-    let poses: Vec<Pose> = (0..30)
-        .map(|k| {
-            let mut p = Pose::rest(&body);
-            p.x[Joint::LeftElbow.dof_offset()] = if (10..20).contains(&k) { 170f64.to_radians() } else { 1.0 };
-            p
-        })
-        .collect();
-    let input = dir.path().join("over.bvh");
-    write_bvh(&Motion { body, frame_time_s: 1.0 / 30.0, poses }.to_bvh(), &mut fs::File::create(&input).unwrap())
-        .unwrap();
+    let input = write_take(&dir.path().join("over.bvh"), 30, |k, x| {
+        x[Joint::LeftElbow.dof_offset()] = if (10..20).contains(&k) { 170f64.to_radians() } else { 1.0 };
+    });
     let run = dir.path().join("run");
     let s = executed(&input, &run, &["--fixed-base", "-q"]);
     assert_eq!(s["clamped_frames"], 10, "{s}");
