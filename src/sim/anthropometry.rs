@@ -207,3 +207,39 @@ pub fn torque_limit_nm(body: &Body, j: Joint) -> Option<f64> {
     };
     Some(standard * body_mass_kg(body) / STANDARD_MASS_KG)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mocap::body::Proportions;
+
+    #[test]
+    fn the_parts_weigh_the_whole_body_and_scale_with_its_height() {
+        for height_m in [1.2, 1.75, 2.2] {
+            let body = Body::new(Proportions { height_m, ..Default::default() });
+            let parts: f64 = inertials(&body).iter().map(|i| i.mass_kg).sum();
+            let whole = body_mass_kg(&body);
+            assert!((parts - whole).abs() < 1e-9 * whole, "{height_m} m: {parts} of {whole} kg");
+            assert!((whole - 70.0 * (height_m / 1.75f64).powi(2)).abs() < 1e-9);
+        }
+        let limit =
+            |h: f64| torque_limit_nm(&Body::new(Proportions { height_m: h, ..Default::default() }), Joint::LeftElbow);
+        assert_eq!(limit(1.75), Some(80.0));
+        assert!((limit(2.1).unwrap() - 80.0 * 1.44).abs() < 1e-9);
+        assert_eq!(torque_limit_nm(&Body::standard(), Joint::Pelvis), None);
+    }
+
+    #[test]
+    fn each_limbs_centre_of_mass_lies_on_its_bone_and_its_inertia_is_smallest_along_it() {
+        let body = Body::new(Proportions { height_m: 1.75, arm_scale: 1.2, leg_scale: 0.9 });
+        let parts = inertials(&body);
+        for j in [Joint::LeftShoulder, Joint::RightElbow, Joint::LeftHip, Joint::RightKnee] {
+            let (bone, part) = (body.bone(j), parts[j.index()]);
+            let share = part.com.dot(bone) / bone.length_squared();
+            assert!((0.4..0.45).contains(&share) && part.com.cross(bone).length() < 1e-12, "{j:?}: {share}");
+            // A limb turns most easily about its own length.
+            let along = if bone.x.abs() > bone.y.abs() { part.inertia.x } else { part.inertia.y };
+            assert!(part.inertia.to_array().iter().all(|&i| i >= along && i > 0.0), "{j:?}: {}", part.inertia);
+        }
+    }
+}
