@@ -96,6 +96,26 @@ fn a_run_becomes_a_self_contained_page_whose_numbers_are_those_of_metrics_json()
         assert_eq!(fs::read(report.join(file)).unwrap(), fs::read(dir.join("again").join(file)).unwrap(), "{file}");
     }
 
+    // With the humanoid's execution of the run's trajectory, the page says
+    // how it followed, joint by joint, and shows it over the trajectory.
+    ok(run(dir, &["execute", "run/trajectory.bvh", "-o", "humanoid", "--fixed-base"]));
+    ok(run(dir, &["report", "run", "--truth", "video/truth.csv", "--execution", "humanoid", "-o", "imitation"]));
+    let html = fs::read_to_string(dir.join("imitation/index.html")).unwrap();
+    let execution: serde_json::Value =
+        serde_json::from_slice(&fs::read(dir.join("humanoid/summary.json")).unwrap()).unwrap();
+    let rms = execution["rms_error_deg"].as_f64().unwrap();
+    assert!(html.contains(&format!("its joints followed within {rms:.2}° RMS")), "{rms}");
+    assert!(html.contains("on a stand (fixed base)"));
+    let elbow = &execution["joints"].as_array().unwrap()[5];
+    assert_eq!(elbow["joint"], "left_elbow");
+    let cells = format!("<td>left_elbow</td><td>{:.2}</td>", elbow["rms_error_deg"].as_f64().unwrap());
+    assert!(html.contains(&cells), "{cells}");
+    assert_eq!(html.matches("<img ").count(), 4, "and the humanoid's filmstrip");
+    let strip = image::open(dir.join("imitation/humanoid.png")).unwrap();
+    assert_eq!(strip.width(), image::open(report.join("filmstrip.png")).unwrap().width());
+    // The rest of the report is as without it.
+    assert_eq!(fs::read(dir.join("imitation/metrics.json")).unwrap(), fs::read(report.join("metrics.json")).unwrap());
+
     // A baseline run has no primitives' curves: the page says so and still
     // shows the error and the filmstrip.
     ok(run(dir, &["report", "baseline", "--truth", "video/truth.csv"]));
@@ -105,6 +125,7 @@ fn a_run_becomes_a_self_contained_page_whose_numbers_are_those_of_metrics_json()
     assert!(dir.join("baseline/report/filmstrip.png").is_file());
 
     browser_check(&report.join("index.html"), "report-screenshot.png");
+    browser_check(&dir.join("imitation/index.html"), "report-imitation-screenshot.png");
 }
 
 fn refused(dir: &Path, args: &[&str], says: &str) {
@@ -143,6 +164,14 @@ fn bad_input_is_refused_with_nothing_written() {
     fs::create_dir(dir.join("elsewhere")).unwrap();
     let run_dir = dir.join("run").display().to_string();
     refused(&dir.join("elsewhere"), &["report", &run_dir], "(pass --frames if they moved)");
+    assert!(!dir.join("run/report").exists());
+    // An execution of another take, or of part of the trajectory.
+    let take = shipped("mocap/wave-h.bvh");
+    ok(run(dir, &["execute", take.to_str().unwrap(), "-o", "other", "--fixed-base"]));
+    refused(dir, &["report", "run", "--execution", "other"], "other/summary.json: the humanoid played");
+    ok(run(dir, &["execute", "run/trajectory.bvh", "-o", "part", "--fixed-base", "--skip", "1"]));
+    refused(dir, &["report", "run", "--execution", "part"], "(after skipping 1), but");
+    refused(dir, &["report", "run", "--execution", "nowhere"], "nowhere/summary.json: cannot read");
     assert!(!dir.join("run/report").exists());
     // An output folder that holds something.
     fs::create_dir(dir.join("taken")).unwrap();

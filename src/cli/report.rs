@@ -4,6 +4,7 @@ use super::{Global, Outcome, UsageError, note, refuse_nonempty};
 use anyhow::{Context, bail};
 use imitate::fsutil::write_dir_atomic;
 use imitate::report::filmstrip::{MAX_FRAMES, pick_frames};
+use imitate::report::imitation::read_imitation;
 use imitate::report::metrics::score;
 use imitate::report::page::{Truth, run_report};
 use imitate::report::read_track;
@@ -16,11 +17,14 @@ use std::path::{Path, PathBuf};
 
 /// Turn one `imitate track` run into a report: Figure 8 (attractor
 /// progress and activity probabilities per primitive), a filmstrip of the
-/// silhouettes with the estimate drawn over them and seen from above, and,
-/// with --truth, the error over time, the scores and the confusion matrix.
+/// silhouettes with the estimate drawn over them and seen from above;
+/// with --truth, the error over time, the scores and the confusion matrix;
+/// with --execution, how the simulated humanoid played the run's virtual
+/// trajectory, and a filmstrip of it.
 ///
 /// Writes DIR/index.html (self-contained: opens from disk, no network),
-/// the plots as PNG and SVG, filmstrip.png, and with --truth metrics.json.
+/// the plots as PNG and SVG, filmstrip.png, with --truth metrics.json, and
+/// with --execution humanoid.png.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The tracking run's folder (frames.csv, likelihoods.csv, summary.json).
@@ -33,6 +37,9 @@ pub struct Args {
     /// summary.json].
     #[arg(long, value_name = "FRAMES")]
     pub frames: Option<PathBuf>,
+    /// An `imitate execute` folder of the run's trajectory.bvh.
+    #[arg(long, value_name = "DIR")]
+    pub execution: Option<PathBuf>,
     /// Where to write the report [default: RUN_DIR/report].
     #[arg(short, long, value_name = "DIR")]
     pub output: Option<PathBuf>,
@@ -89,7 +96,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         None => format!("the frames {} names (pass --frames if they moved)", summary.display()),
     })?;
     let truth_view = truth.as_ref().zip(metrics.as_ref()).map(|(track, metrics)| Truth { track, metrics });
-    let mut files = run_report(&run, truth_view, &camera, &picks, &observed);
+    let imitation = args.execution.as_deref().map(|dir| read_imitation(dir, &run.track)).transpose()?;
+    let mut files = run_report(&run, truth_view, imitation.as_ref(), &camera, &picks, &observed);
     if let Some(m) = &metrics {
         let json = serde_json::to_string_pretty(m).expect("metrics are plain numbers and maps") + "\n";
         files.push(("metrics.json".into(), json.into_bytes()));

@@ -6,6 +6,7 @@ pub mod eval;
 pub mod figures;
 pub mod filmstrip;
 pub mod html;
+pub mod imitation;
 pub mod metrics;
 pub mod page;
 pub mod plot;

@@ -5,6 +5,7 @@
 use super::figures;
 use super::filmstrip::filmstrip;
 use super::html::Page;
+use super::imitation::Imitation;
 use super::metrics::{Metrics, Track};
 use super::run::Run;
 use crate::vision::camera::Camera;
@@ -59,8 +60,16 @@ pub fn score_rows(m: &Metrics) -> Vec<Vec<String>> {
 }
 
 /// The report of `run`: `index.html` and its pictures (PNG and SVG),
-/// with `observed[k]` the silhouette of frame `picks[k]`.
-pub fn run_report(run: &Run, truth: Option<Truth>, camera: &Camera, picks: &[usize], observed: &[Mask]) -> Vec<File> {
+/// with `observed[k]` the silhouette of frame `picks[k]`, and how the
+/// humanoid played its trajectory when it did.
+pub fn run_report(
+    run: &Run,
+    truth: Option<Truth>,
+    imitation: Option<&Imitation>,
+    camera: &Camera,
+    picks: &[usize],
+    observed: &[Mask],
+) -> Vec<File> {
     let mut files: Vec<File> = Vec::new();
     let mut page = Page::new(&format!("Tracking report: {}", run.dir.display()));
     let s = &run.summary;
@@ -107,6 +116,25 @@ pub fn run_report(run: &Run, truth: Option<Truth>, camera: &Camera, picks: &[usi
             "Top: the observed silhouette (gray) with the estimate (blue) and the truth (orange, when known) drawn from \
              the camera. Bottom: the same seen from above, the camera's side down.");
         files.push(("filmstrip.png".into(), strip));
+    }
+    if let Some(imitation) = imitation {
+        page.heading("Imitation on the humanoid");
+        page.paragraph(&imitation.sentence());
+        let header = ["joint", "RMS error (°)", "worst (°)", "peak torque (N·m)", "cap (N·m)", "steps at cap"];
+        page.table(&header.map(String::from), &imitation.rows());
+        if !picks.is_empty() {
+            let strip = filmstrip(camera, &run.track, Some(&imitation.humanoid), picks, observed);
+            page.image(
+                &strip,
+                "image/png",
+                "the humanoid playing the virtual trajectory",
+                "Top: the observed silhouette (gray) with the virtual trajectory (blue) and the humanoid playing it \
+                 (orange) drawn from the camera. Bottom: the same seen from above, the camera's side down. Standing on \
+                 the ground, the humanoid stays where it started: only its joints follow, not the root the tracker \
+                 estimated.",
+            );
+            files.push(("humanoid.png".into(), strip));
+        }
     }
     page.heading("Settings");
     let settings = serde_json::to_string_pretty(&s.settings).expect("settings are JSON");
