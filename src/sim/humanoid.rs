@@ -282,15 +282,15 @@ impl Humanoid {
             let parent = self.rotation(j.parent().expect("only the pelvis has no parent"));
             let target = targets[j.index()];
             let data = &mut self.world.impulse_joints.get_mut(actuator.handle, false).expect(JOINT).data;
-            // Each motor's axis in the parent's frame, and where its zero lies.
-            let (axes, zero): ([DVec3; 3], f64) = match j.kind() {
-                Kind::Hinge { axis, .. } => ([axis, DVec3::ZERO, DVec3::ZERO], hinge_angle(target.rotation, axis)),
+            // Where each motor's zero lies.
+            let zero = match j.kind() {
+                Kind::Hinge { axis, .. } => hinge_angle(target.rotation, axis),
                 Kind::Ball { .. } => {
                     data.local_frame1.rotation = target.rotation.as_quat();
-                    ([DVec3::X, DVec3::Y, DVec3::Z].map(|a| target.rotation * a), 0.0)
+                    0.0
                 }
             };
-            for (&motor, along) in actuator.axes.iter().zip(axes) {
+            for (&motor, along) in actuator.axes.iter().zip(motor_axes(j, target.rotation)) {
                 let world_axis = parent * along;
                 let inertia = world_axis.dot(turned[j.index()] * world_axis);
                 let rate = target.spin.dot(along);
@@ -397,13 +397,7 @@ impl Humanoid {
             let most = self.torque_limits[j.index()] * substep;
             let impulses = actuator.axes.iter().map(|&axis| data.motor(axis).map_or(0.0, |m| f64::from(m.impulse)));
             let (mut sum, mut limited) = (DVec3::ZERO, false);
-            for (impulse, k) in impulses.zip(0..) {
-                // A hinge's motor turns about its axis; a ball joint's about
-                // the axes of its target frame.
-                let along = match j.kind() {
-                    Kind::Hinge { axis, .. } => axis,
-                    Kind::Ball { .. } => to_f64(data.local_frame1.rotation) * DVec3::AXES[k],
-                };
+            for (impulse, along) in impulses.zip(motor_axes(j, to_f64(data.local_frame1.rotation))) {
                 sum += along * impulse;
                 // rapier caps each impulse at the limit times the substep,
                 // in f32.
@@ -474,6 +468,16 @@ fn motorized_joint(j: Joint, anchor: DVec3, torque_limit_nm: f64) -> (GenericJoi
         joint.set_motor_model(axis, MotorModel::ForceBased).set_motor_max_force(axis, torque_limit_nm as f32);
     }
     (joint, axes)
+}
+
+/// The axes joint `j`'s motors turn about, in its parent's frame: a hinge's
+/// axis, or the axes of a ball joint's target frame `target` (unused
+/// entries zero).
+fn motor_axes(j: Joint, target: DQuat) -> [DVec3; 3] {
+    match j.kind() {
+        Kind::Hinge { axis, .. } => [axis, DVec3::ZERO, DVec3::ZERO],
+        Kind::Ball { .. } => DVec3::AXES.map(|a| target * a),
+    }
 }
 
 /// The foot at the end of the leg `j` belongs to, if it is a leg joint.
