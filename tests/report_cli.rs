@@ -172,6 +172,12 @@ fn bad_input_is_refused_with_nothing_written() {
     ok(run(dir, &["execute", "run/trajectory.bvh", "-o", "part", "--fixed-base", "--skip", "1"]));
     refused(dir, &["report", "run", "--execution", "part"], "(after skipping 1), but");
     refused(dir, &["report", "run", "--execution", "nowhere"], "nowhere/summary.json: cannot read");
+    // One whose executed.bvh is gone: the error names that file once.
+    ok(run(dir, &["execute", "run/trajectory.bvh", "-o", "no-bvh", "--fixed-base"]));
+    fs::remove_file(dir.join("no-bvh/executed.bvh")).unwrap();
+    refused(dir, &["report", "run", "--execution", "no-bvh"], "no-bvh/executed.bvh: cannot read");
+    let out = run(dir, &["report", "run", "--execution", "no-bvh"]);
+    assert_eq!(String::from_utf8_lossy(&out.stderr).matches("executed.bvh").count(), 1);
     assert!(!dir.join("run/report").exists());
     // An output folder that holds something.
     fs::create_dir(dir.join("taken")).unwrap();

@@ -43,7 +43,7 @@ pub struct Imitation {
 pub fn read_imitation(dir: &Path, run: &Track) -> Result<Imitation, ReportError> {
     let path = dir.join("summary.json");
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(&path).map_err(|source| ReportError::Read { file: file.clone(), source })?;
+    let text = super::read(&path)?;
     let summary: ExecutionSummary = serde_json::from_str(&text)
         .map_err(|e| ReportError::Summary { file: file.clone(), message: format!("not an execution summary: {e}") })?;
     if summary.skipped_frames != 0 || summary.frames != run.frame.len() {
@@ -61,7 +61,7 @@ pub fn read_imitation(dir: &Path, run: &Track) -> Result<Imitation, ReportError>
     }
     let path = dir.join("executed.bvh");
     let file = path.display().to_string();
-    let bvh = read_bvh(&path).map_err(|e| ReportError::Summary { file: file.clone(), message: e.to_string() })?;
+    let bvh = read_bvh(&path)?;
     let motion = Retargeter::new(&bvh, &RetargetOptions::default())
         .map_err(|e| ReportError::Summary { file: file.clone(), message: e.to_string() })?
         .retarget(&bvh);

@@ -37,6 +37,9 @@ pub enum ReportError {
     FrameMismatch { estimate: String, estimated: u64, truth: String, truth_frame: u64, row: usize },
     #[error("{file}: frame {frame}: {from} and {to} are at the same place, so the bone has no direction")]
     DegenerateBone { file: String, frame: u64, from: &'static str, to: &'static str },
+    /// It names its file itself.
+    #[error(transparent)]
+    Bvh(#[from] crate::mocap::bvh::BvhError),
 }
 
 /// A body's path through a video, one entry per frame: the columns that
