@@ -171,9 +171,10 @@ impl Targets {
         let (d10, d01, d11) = (3.0 * u2 - 4.0 * u + 1.0, -6.0 * u2 + 6.0 * u, 3.0 * u2 - 2.0 * u);
         for j in motorized() {
             let at_k = self.rotations[k][j.index()];
+            let from_k = at_k.inverse();
             // The frames around, as rotations away from frame k: small,
             // whatever the joint's own angle.
-            let away = |f: usize| log_map(at_k.inverse() * self.rotations[f][j.index()]);
+            let away = |f: usize| log_map(from_k * self.rotations[f][j.index()]);
             let next = away(k + 1);
             // Beyond either end the curve is carried on in a straight line.
             let before = if k > 0 { away(k - 1) } else { -next };
