@@ -144,10 +144,10 @@ fn retarget_writes_canonical_bvh_and_reports_how_closely_it_follows_the_source()
 }
 
 #[test]
-fn retarget_needs_a_mapping_for_unknown_names_and_uses_one_when_given() {
+fn retarget_maps_unknown_names_from_the_structure_and_uses_a_mapping_file_when_given() {
     let tmp = tempfile::tempdir().unwrap();
     let input = tmp.path().join("robot.bvh");
-    // A canonical take with every joint renamed.
+    // A canonical take with every joint renamed to something no scheme knows.
     let take = imitate::mocap::synth::activity_take(imitate::mocap::synth::Activity::WaveV, &Default::default());
     let mut bvh = take.motion.to_bvh();
     for joint in &mut bvh.skeleton.joints {
@@ -158,11 +158,12 @@ fn retarget_needs_a_mapping_for_unknown_names_and_uses_one_when_given() {
     fs::write(&input, text).unwrap();
     let output = tmp.path().join("out.bvh");
     let out = imitate().args(["retarget", input.to_str().unwrap(), "-o", output.to_str().unwrap()]).output().unwrap();
-    assert_eq!(out.status.code(), Some(1));
-    let err = stderr_of(&out);
-    assert!(err.starts_with(&format!("imitate: error: {}: cannot map the skeleton", input.display())), "{err}");
-    assert!(err.contains("left_elbow = \"<source joint name>\"") && err.contains("Link_leftelbow"), "{err}");
-    assert!(!output.exists());
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    assert!(stderr_of(&out).contains("within 0.00°"), "{}", stderr_of(&out));
+    let inspect = imitate().args(["inspect", input.to_str().unwrap()]).output().unwrap();
+    let report = String::from_utf8_lossy(&inspect.stdout).to_string();
+    assert!(report.contains("naming      structure"), "{report}");
+    assert!(report.contains("left_elbow ← Link_leftelbow (the limb's hinge; side from the pose)"), "{report}");
 
     let mapping = tmp.path().join("mapping.toml");
     let entries: String = imitate::mocap::body::Joint::ALL
@@ -176,6 +177,25 @@ fn retarget_needs_a_mapping_for_unknown_names_and_uses_one_when_given() {
         .unwrap();
     assert!(out.status.success(), "{}", stderr_of(&out));
     assert!(stderr_of(&out).contains("within 0.00°"), "{}", stderr_of(&out));
+}
+
+#[test]
+fn a_skeleton_without_arms_is_an_error_that_shows_the_mapping_file_to_write() {
+    let tmp = tempfile::tempdir().unwrap();
+    let input = tmp.path().join("trunk.bvh");
+    let text = "HIERARCHY\nROOT Base\n{\nOFFSET 0 0 0\nCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n\
+        JOINT Mid\n{\nOFFSET 0 30 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n\
+        JOINT Top\n{\nOFFSET 0 30 0\nCHANNELS 3 Zrotation Xrotation Yrotation\nEnd Site\n{\nOFFSET 0 20 0\n}\n}\n}\n}\n\
+        MOTION\nFrames: 2\nFrame Time: 0.1\n0 90 0 0 0 0 0 0 0 0 0 0\n0 90 0 0 0 0 5 0 0 0 0 0\n";
+    fs::write(&input, text).unwrap();
+    let output = tmp.path().join("out.bvh");
+    let out = imitate().args(["retarget", input.to_str().unwrap(), "-o", output.to_str().unwrap()]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr_of(&out);
+    assert!(err.starts_with(&format!("imitate: error: {}: cannot map the skeleton", input.display())), "{err}");
+    assert!(err.contains("its structure gives no body: it has 0 limbs"), "{err}");
+    assert!(err.contains("left_elbow = \"<source joint name>\"") && err.contains("Base, Mid, Top"), "{err}");
+    assert!(!output.exists());
 }
 
 #[test]

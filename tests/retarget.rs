@@ -6,8 +6,8 @@ mod common;
 use glam::DVec3;
 use imitate::mocap::body::{Body, Joint};
 use imitate::mocap::bvh::{read_bvh, read_bvh_bytes, write_bvh};
+use imitate::mocap::mapping::UserMapping;
 use imitate::mocap::math::log_map;
-use imitate::mocap::names::UserMapping;
 use imitate::mocap::pose::Motion;
 use imitate::mocap::retarget::{DirectionErrors, RetargetError, RetargetOptions, Retargeter, UpAxis};
 use imitate::mocap::synth::{Activity, SynthOptions, activity_take};
@@ -159,12 +159,12 @@ fn limbs_never_turn_far_more_than_the_source_limb_joint_turns() {
     // The source's own twist is followed, noise and all: some captures spin
     // a nearly straight overhead arm by 60° a frame.
     use imitate::mocap::fk::{Kinematics, Transform};
-    use imitate::mocap::names::{Landmark, map_skeleton};
+    use imitate::mocap::mapping::{Landmark, map_skeleton};
     for path in common::real_bvh_files() {
         let bvh = read_bvh(&path).unwrap();
         let (_, motion) = retarget(&bvh);
-        let mapping = map_skeleton(&bvh.skeleton, None).unwrap();
         let kin = Kinematics::new(&bvh);
+        let mapping = map_skeleton(&bvh, &kin, None).unwrap();
         let all = vec![true; bvh.skeleton.joints.len()];
         let mut world = vec![vec![Transform::default(); all.len()]; 2];
         let mut flips = Vec::new();
@@ -305,13 +305,44 @@ Frame Time: 0.04
 ";
 
 #[test]
-fn an_unmappable_skeleton_is_an_error_listing_the_missing_joints_and_how_to_map_them() {
+fn an_unknown_upper_body_maps_from_its_structure_as_a_mapping_file_would() {
     let bvh = read_bvh_bytes(UNKNOWN_NAMES.as_bytes(), "odd.bvh").unwrap();
+    let r = Retargeter::new(&bvh, &RetargetOptions::default()).expect("the structure maps it");
+    let a = r.analysis();
+    assert_eq!(a.scheme, "structure");
+    let source = |canonical: &str| a.mapping.iter().find(|m| m.canonical == canonical).and_then(|m| m.source.clone());
+    for (canonical, joint) in [
+        ("pelvis", "Root"),
+        ("chest", "Torso"),
+        ("neck", "NeckBase"),
+        ("head", "Skull"),
+        ("left_shoulder", "ArmL"),
+        ("left_elbow", "ElbowL"),
+        ("left_wrist", "HandL"),
+        ("right_shoulder", "ArmR"),
+        ("right_elbow", "ElbowR"),
+        ("right_wrist", "HandR"),
+    ] {
+        assert_eq!(source(canonical).as_deref(), Some(joint), "{canonical}");
+    }
+    assert!(a.warnings.iter().any(|w| w.code == "legs_unmapped"));
+}
+
+#[test]
+fn a_skeleton_without_arms_is_an_error_listing_the_missing_joints_and_how_to_map_them() {
+    // The same body with its arms cut off: nothing can play them.
+    let start = UNKNOWN_NAMES.find("      JOINT ArmL").unwrap();
+    let end = UNKNOWN_NAMES.find("    }\n  }\n}\nMOTION").unwrap();
+    let armless = format!("{}{}", &UNKNOWN_NAMES[..start], &UNKNOWN_NAMES[end..]);
+    let motion = armless.find("MOTION").unwrap();
+    // Six channels on the root and three on each of the four other joints.
+    let armless =
+        format!("{}MOTION\nFrames: 1\nFrame Time: 0.04\n0 100 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0\n", &armless[..motion]);
+    let bvh = read_bvh_bytes(armless.as_bytes(), "armless.bvh").unwrap();
     let Err(err) = Retargeter::new(&bvh, &RetargetOptions::default()) else { panic!("should not map") };
     assert!(matches!(err, RetargetError::Unmapped { .. }));
     let message = err.to_string();
-    for expected in
-        ["spine", "left_elbow", "right_wrist", "--map", "left_elbow = \"<source joint name>\"", "ElbowL, HandL"]
+    for expected in ["left_elbow", "right_wrist", "--map", "left_elbow = \"<source joint name>\"", "Root, Waist, Torso"]
     {
         assert!(message.contains(expected), "message lacks `{expected}`:\n{message}");
     }

@@ -218,9 +218,36 @@ fn write_text(report: &Report, out: &mut String) {
             field(out, "units", units);
             field(out, "up axis", format!("{} ({})", a.up_axis, if a.up_detected { "detected" } else { "from --up" }));
             field(out, "naming", a.scheme.to_string());
-            let pairs: Vec<String> =
-                a.mapping.iter().filter_map(|m| m.source.as_ref().map(|s| format!("{} ← {s}", m.canonical))).collect();
-            wrapped(out, "mapping", &pairs);
+            // One list per rule: by name, by structure (each saying how),
+            // by the mapping file.
+            let mut first = true;
+            for (rule, label) in [("name", "by name"), ("structure", "by structure"), ("file", "by mapping file")] {
+                let mut items: Vec<String> = a
+                    .mapping
+                    .iter()
+                    .filter(|m| m.rule == Some(rule))
+                    .filter_map(|m| {
+                        let source = m.source.as_ref()?;
+                        let how = m.how.as_deref().unwrap_or_default();
+                        Some(if rule == "structure" {
+                            format!("{} ← {source} ({how})", m.canonical)
+                        } else {
+                            format!("{} ← {source}", m.canonical)
+                        })
+                    })
+                    .collect();
+                let Some(head) = items.first_mut() else {
+                    continue;
+                };
+                let how =
+                    a.mapping.iter().find(|m| m.rule == Some(rule)).and_then(|m| m.how.clone()).unwrap_or_default();
+                *head = match rule {
+                    "structure" => format!("{label}: {head}"),
+                    _ => format!("{label} ({how}): {head}"),
+                };
+                wrapped(out, if first { "mapping" } else { "" }, &items);
+                first = false;
+            }
             let missing = if a.missing.is_empty() {
                 vec!["none".to_string()]
             } else {

@@ -4,7 +4,7 @@ use super::{Global, Outcome, note, progress};
 use anyhow::Context;
 use imitate::fsutil::write_atomic;
 use imitate::mocap::bvh::{read_bvh, write_bvh};
-use imitate::mocap::names::UserMapping;
+use imitate::mocap::mapping::UserMapping;
 use imitate::mocap::retarget::{DirectionErrors, RetargetOptions, Retargeter, UpAxis};
 use imitate::vocab::stages::RetargetSettings;
 use std::path::PathBuf;

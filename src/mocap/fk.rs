@@ -139,7 +139,13 @@ impl Kinematics {
 
 /// Up to [`SAMPLE_FRAMES`] frame indices spread evenly over the take.
 pub fn sample_frames(frames: usize) -> Vec<usize> {
-    let n = frames.min(SAMPLE_FRAMES);
+    spread_frames(frames, SAMPLE_FRAMES)
+}
+
+/// Up to `count` frame indices spread evenly over the take, first and last
+/// included.
+pub fn spread_frames(frames: usize, count: usize) -> Vec<usize> {
+    let n = frames.min(count);
     (0..n).map(|i| if n == 1 { 0 } else { i * (frames - 1) / (n - 1) }).collect()
 }
 

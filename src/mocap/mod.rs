@@ -4,8 +4,8 @@
 pub mod body;
 pub mod bvh;
 pub mod fk;
+pub mod mapping;
 pub mod math;
-pub mod names;
 pub mod pose;
 pub mod retarget;
 pub mod synth;

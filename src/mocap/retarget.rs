@@ -18,8 +18,8 @@
 use crate::mocap::body::{Body, JOINTS, Joint, Kind};
 use crate::mocap::bvh::{Bvh, Warning};
 use crate::mocap::fk::{Kinematics, PositionMode, Transform, sample_frames};
+use crate::mocap::mapping::{Landmark, Mapping, MappingError, SourcePoint, UserMapping, joint_list, map_skeleton};
 use crate::mocap::math::{Axis, frame_from_directions, smoothstep5};
-use crate::mocap::names::{Landmark, Mapping, MappingError, SourcePoint, UserMapping, joint_list, map_skeleton};
 use crate::mocap::pose::{Motion, Pose};
 use glam::{DMat3, DQuat, DVec3};
 use rayon::prelude::*;
@@ -51,11 +51,15 @@ pub struct RetargetOptions {
     pub mapping: Option<UserMapping>,
 }
 
-/// One canonical landmark and where it was found.
+/// One canonical landmark, where it was found and by which rule.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct MappedLandmark {
     pub canonical: &'static str,
     pub source: Option<String>,
+    /// `name`, `structure` or `file`; absent for a landmark not found.
+    pub rule: Option<&'static str>,
+    /// The naming scheme, how the structure placed it, or the mapping file.
+    pub how: Option<String>,
 }
 
 /// What retargeting learned about a source skeleton.
@@ -85,18 +89,21 @@ pub struct Analysis {
 pub enum RetargetError {
     #[error(transparent)]
     Mapping(#[from] MappingError),
-    #[error("{}", unmapped_message(.scheme, .missing, .joints))]
-    Unmapped { scheme: &'static str, missing: Vec<&'static str>, joints: String },
+    #[error("{}", unmapped_message(.scheme, .missing, .joints, .structure))]
+    Unmapped { scheme: &'static str, missing: Vec<&'static str>, joints: String, structure: Option<String> },
     #[error("the file has no frames of motion to retarget")]
     NoFrames,
+    #[error("the file has {} ROOT hierarchies ({}): a capture of one body has one; keep the body's and remove the others", .0.len(), .0.join(", "))]
+    MultipleRoots(Vec<String>),
     #[error("the skeleton has no length: its mapped joints all sit at one point")]
     Degenerate,
 }
 
-fn unmapped_message(scheme: &str, missing: &[&str], joints: &str) -> String {
+fn unmapped_message(scheme: &str, missing: &[&str], joints: &str, structure: &Option<String>) -> String {
     let example: String = missing.iter().map(|m| format!("    {m} = \"<source joint name>\"\n")).collect();
+    let structure = structure.as_ref().map(|why| format!("; its structure gives no body: {why}")).unwrap_or_default();
     format!(
-        "cannot map the skeleton onto the canonical body: no source joint for {} (closest built-in naming scheme: {scheme}).\n\
+        "cannot map the skeleton onto the canonical body: no source joint for {} (closest built-in naming scheme: {scheme}{structure}).\n\
          Write a mapping file naming the source joint for each, and pass it with --map:\n\
          \n    # mapping.toml: canonical joint = source joint; {{ end_of = \"J\" }} names J's End Site\n{example}\n\
          The skeleton's joints are: {joints}",
@@ -197,19 +204,24 @@ impl Retargeter {
     /// calibrates the twist fallbacks.
     pub fn new(bvh: &Bvh, options: &RetargetOptions) -> Result<Retargeter, RetargetError> {
         let skeleton = &bvh.skeleton;
-        let mapping = map_skeleton(skeleton, options.mapping.as_ref())?;
+        let roots: Vec<String> = skeleton.roots().map(|r| skeleton.joints[r].name.clone()).collect();
+        if roots.len() > 1 {
+            return Err(RetargetError::MultipleRoots(roots));
+        }
+        let kin = Kinematics::new(bvh);
+        let mapping = map_skeleton(bvh, &kin, options.mapping.as_ref())?;
         let missing_required = mapping.missing_required();
         if !missing_required.is_empty() {
             return Err(RetargetError::Unmapped {
                 scheme: mapping.scheme,
                 missing: missing_required.iter().map(|l| l.name()).collect(),
                 joints: joint_list(skeleton),
+                structure: mapping.structure_error.as_ref().map(|e| e.to_string()),
             });
         }
         if bvh.frames == 0 {
             return Err(RetargetError::NoFrames);
         }
-        let kin = Kinematics::new(bvh);
         let mut points = [None; LANDMARKS];
         for (l, p) in &mapping.points {
             points[l.slot()] = Some(*p);
@@ -413,9 +425,15 @@ impl Retargeter {
         }
         let a = &mut self.analysis;
         a.mapping = Landmark::all()
-            .map(|l| MappedLandmark {
-                canonical: l.name(),
-                source: self.points[l.slot()].map(|p| p.describe(skeleton)),
+            .map(|l| {
+                let source = self.points[l.slot()];
+                let rule = source.and(mapping.rules.get(&l));
+                MappedLandmark {
+                    canonical: l.name(),
+                    source: source.map(|p| p.describe(skeleton)),
+                    rule: rule.map(|r| r.kind()),
+                    how: rule.map(|r| r.detail().to_string()),
+                }
             })
             .collect();
         let missing: Vec<Landmark> = Landmark::all().filter(|l| self.points[l.slot()].is_none()).collect();

@@ -16,7 +16,7 @@
 
 use crate::fsutil::write_dir_atomic;
 use crate::mocap::body::{DOF, Joint, Kind};
-use crate::mocap::names::{MappingError, UserMapping};
+use crate::mocap::mapping::{MappingError, UserMapping};
 use crate::mocap::retarget::{RetargetOptions, UpAxis};
 use crate::vocab::cluster::{Choice, ClusterParams, Clustering, Tried};
 use crate::vocab::corpus::{self, Corpus, CorpusError};

@@ -9,7 +9,13 @@ use std::process::Command;
 /// Absent outside CI, the caller skips (and says so); under CI (the `CI`
 /// variable set) its absence fails the test.
 pub fn real_mocap_dir() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/mocap/real");
+    shared_mocap_dir("real")
+}
+
+/// `../shared/mocap/CORPUS` (`real`, `bandai`, `m21`): absent outside CI,
+/// the caller skips (and says so); under CI its absence fails the test.
+pub fn shared_mocap_dir(corpus: &str) -> Option<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/mocap").join(corpus);
     if dir.is_dir() {
         return Some(dir);
     }

@@ -354,7 +354,7 @@ impl<R: BufRead> Reader<R> {
         }
         if roots > 1 {
             let message = format!(
-                "the file has {roots} ROOT hierarchies; all are read, and the body is taken from the first (`{}`)",
+                "the file has {roots} ROOT hierarchies (the first is `{}`); all are read, but a body is one hierarchy, so retargeting refuses the file",
                 joints[0].name
             );
             self.warn("multiple_roots", message);
