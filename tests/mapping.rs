@@ -10,9 +10,10 @@ mod skeletons;
 
 use imitate::mocap::body::Joint;
 use imitate::mocap::bvh::{Bvh, read_bvh};
+use imitate::mocap::fidelity::DirectionErrors;
 use imitate::mocap::fk::Kinematics;
 use imitate::mocap::mapping::{Landmark, Mapping, map_skeleton};
-use imitate::mocap::retarget::{DirectionErrors, RetargetOptions, Retargeter};
+use imitate::mocap::retarget::{RetargetOptions, Retargeter};
 use skeletons::{Variation, generate, templates};
 use std::path::PathBuf;
 
@@ -124,7 +125,7 @@ fn every_file_of_the_shared_corpora_maps_without_a_mapping_file() {
                 mapping.missing_required()
             );
             // The legs are the last six canonical joints.
-            for leg in &Joint::ALL[Joint::LeftHip.index()..] {
+            for &leg in &Joint::ALL[Joint::LeftHip.index()..] {
                 assert!(mapping.get(Landmark::Joint(leg)).is_some(), "{}: no {}", path.display(), leg.name());
             }
         }

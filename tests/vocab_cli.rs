@@ -94,9 +94,21 @@ fn excerpt(source: &Path, frames: std::ops::Range<usize>, path: &Path, repeat_fi
 fn the_stages_run_one_by_one_write_the_vocabulary_vocab_build_writes() {
     let tmp = tempfile::tempdir().unwrap();
     let t = |name: &str| tmp.path().join(name);
-    // A take too short to give a segment is still recorded as learned from.
+    // A take too short to give a segment is skipped, said so, and still
+    // recorded as learned from.
     excerpt(&mocap().join("wave-h.bvh"), 100..104, &t("brief.bvh"), false);
-    ok(&[&"vocab", &"build", &mocap(), &t("brief.bvh"), &"--labels", &labels(), &"-o", &t("built.vocab")]);
+    let built = imitate()
+        .args(["vocab", "build"])
+        .args([mocap(), t("brief.bvh")])
+        .arg("--labels")
+        .arg(labels())
+        .arg("-o")
+        .arg(t("built.vocab"))
+        .output()
+        .unwrap();
+    let said = stderr_of(&built);
+    assert!(built.status.success(), "{said}");
+    assert!(said.contains("brief.bvh: warning: skipped: no segment of at least 0.2 s in its 0.13 s"), "{said}");
     // Parquet and CSV in turn: the format of a stage file changes nothing.
     ok(&[&"segment", &mocap(), &t("brief.bvh"), &"--labels", &labels(), &"-o", &t("segments.parquet")]);
     ok(&[&"embed", &t("segments.parquet"), &"-o", &t("embedding.csv")]);
@@ -160,7 +172,7 @@ fn vocab_info_lists_primitives_dimensions_variance_frames_and_sources() {
     let path = root().join("vocab/default.vocab");
     let vocabulary = Vocabulary::load(&path).unwrap();
     let text = String::from_utf8(ok(&[&"vocab", &"info", &path]).stdout).unwrap();
-    assert!(text.contains("imitate vocabulary, format 1"), "{text}");
+    assert!(text.contains("imitate vocabulary, format 2"), "{text}");
     for p in vocabulary.primitives() {
         let row = text.lines().find(|l| l.split_whitespace().next() == Some(p.name())).unwrap_or_else(|| {
             panic!("no row for {} in:\n{text}", p.name());
@@ -175,7 +187,7 @@ fn vocab_info_lists_primitives_dimensions_variance_frames_and_sources() {
 
     let json = ok(&[&"vocab", &"info", &"--json", &path]).stdout;
     let value: serde_json::Value = serde_json::from_slice(&json).unwrap();
-    assert_eq!(value["format_version"], 1);
+    assert_eq!(value["format_version"], 2);
     assert_eq!(value["checksum"], format!("{:#010x}", vocabulary.checksum().unwrap()));
     let listed = value["primitives"].as_array().unwrap();
     assert_eq!(listed.len(), vocabulary.primitives().len());
@@ -197,16 +209,25 @@ fn inputs_without_motion_to_learn_from_are_refused() {
     excerpt(&circles, 200..204, &dir.join("short.bvh"), false);
     refused(dir, &["segment", "short.bvh", "-o", "s.csv"], "short.bvh", "shorter than the minimum segment length");
     excerpt(&circles, 200..500, &dir.join("still.bvh"), true);
+    refused(dir, &["vocab", "build", "still.bvh", "-o", "v.vocab"], "still.bvh", "every frame is the same pose");
+    // Also among takes that move: the file is wrong, not short.
     refused(
         dir,
-        &["vocab", "build", "still.bvh", "-o", "v.vocab"],
+        &["vocab", "build", &mocap().to_string_lossy(), "still.bvh", "-o", "v.vocab"],
         "still.bvh",
-        "every pose of every take is the same",
+        "every frame is the same pose",
     );
     // Real motion, but too little of it for an embedding.
     excerpt(&circles, 100..260, &dir.join("brief.bvh"), false);
     refused(dir, &["vocab", "build", "brief.bvh", "-o", "v.vocab"], "brief.bvh", "segments");
     refused(dir, &["vocab", "build", &mocap().to_string_lossy(), "--k", "500", "-o", "v.vocab"], "mocap", "--k 500");
+    // A labels file naming a take that is neither given nor beside it.
+    fs::write(dir.join("labels.csv"), "file,activity\ncircles.bvh,circles\ncircels.bvh,circles\n").unwrap();
+    let (circles, labels) = (circles.to_string_lossy(), "labels.csv");
+    for command in [&["vocab", "build"][..], &["segment"]] {
+        let args = [command, &[&circles, "--labels", labels, "-o", "out"]].concat();
+        refused(dir, &args, "labels.csv", "names 1 file neither among the inputs nor beside them: circels.bvh");
+    }
 }
 
 #[test]

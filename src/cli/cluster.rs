@@ -36,8 +36,12 @@ pub fn cluster(mut embedded: Embedded, params: &ValidClusterParams, global: Glob
             let p = params.params();
             let why = match best(tried, p.min_size) {
                 Some(b) if b.k != clustering.k() => format!(
-                    "within {} standard error of the best ({:.3} ± {:.3} at k = {}), the largest k",
-                    p.tolerance, b.silhouette, b.standard_error, b.k
+                    "within {} standard error{} of the best ({:.3} ± {:.3} at k = {}), the largest k",
+                    p.tolerance,
+                    if p.tolerance == 1.0 { "" } else { "s" },
+                    b.silhouette,
+                    b.standard_error,
+                    b.k
                 ),
                 _ => "the best".to_string(),
             };

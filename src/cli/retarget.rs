@@ -4,8 +4,9 @@ use super::{Global, Outcome, note, progress};
 use anyhow::Context;
 use imitate::fsutil::write_atomic;
 use imitate::mocap::bvh::{read_bvh, write_bvh};
+use imitate::mocap::fidelity::DirectionErrors;
 use imitate::mocap::mapping::UserMapping;
-use imitate::mocap::retarget::{DirectionErrors, RetargetOptions, Retargeter, UpAxis};
+use imitate::mocap::retarget::{RetargetOptions, Retargeter, UpAxis};
 use imitate::vocab::stages::RetargetSettings;
 use std::path::PathBuf;
 
@@ -32,7 +33,7 @@ pub struct RetargetArgs {
     #[arg(long, value_enum)]
     pub up: Option<UpArg>,
     /// A mapping file for joints the built-in naming tables do not know
-    /// (`canonical = "Source Joint"`, see the README).
+    /// (`canonical = "Source Joint"`, see docs/formats.md).
     #[arg(long = "map", value_name = "MAPPING.toml")]
     pub mapping: Option<PathBuf>,
 }

@@ -84,6 +84,20 @@ pub fn segment(
     global: Global,
 ) -> anyhow::Result<Segments> {
     let rows = segment_corpus(corpus, params).with_context(|| takes_named(corpus))?;
+    // Takes too short for a segment are left out, not fatal to the corpus.
+    let mut segmented = vec![false; corpus.takes.len()];
+    rows.iter().for_each(|r| segmented[r.take] = true);
+    for (take, _) in corpus.takes.iter().zip(&segmented).filter(|(_, s)| !**s) {
+        let seconds = take.motion.poses.len() as f64 * take.motion.frame_time_s;
+        note(
+            global,
+            &format!(
+                "{}: warning: skipped: no segment of at least {} s in its {seconds:.2} s",
+                take.path,
+                params.params().min_length_s
+            ),
+        );
+    }
     let segments = Segments::new(lineage, corpus, rows);
     let cycles = segments.rows.iter().filter(|r| r.phase_offset.is_some()).count();
     let seconds: f64 = corpus.takes.iter().map(|t| t.motion.poses.len() as f64 * t.motion.frame_time_s).sum();

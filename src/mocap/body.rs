@@ -1,7 +1,7 @@
 //! The canonical humanoid every pose downstream is a pose of: 17 joints,
 //! Y up, facing +Z, the person's left along +X. Its rest pose is a T-pose
 //! (arms along ±X, palms down, legs straight down), so the common arm
-//! postures sit far from the 180° where an exponential map wraps.
+//! postures sit far from a half turn.
 //!
 //! Segment lengths are fractions of standing height after Winter's
 //! anthropometric tables (Biomechanics and Motor Control of Human Movement,
@@ -35,7 +35,7 @@ pub enum Joint {
 /// Number of canonical joints.
 pub const JOINTS: usize = 17;
 
-/// Dimension of joint space: three exponential-map numbers per ball joint
+/// Dimension of joint space: three swing–twist numbers per ball joint
 /// (the pelvis's tilt included), one angle per hinge.
 pub const DOF: usize = 43;
 
@@ -45,7 +45,8 @@ pub type JointVector = [f64; DOF];
 /// How a joint moves.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Kind {
-    /// Three rotational degrees of freedom, stored as an exponential map.
+    /// Three rotational degrees of freedom, stored as swing–twist
+    /// coordinates about the rest bone ([`crate::mocap::math::swing_twist_log`]).
     Ball { max_angle_rad: f64 },
     /// One angle about a fixed axis of the parent's frame.
     Hinge { axis: DVec3, min_rad: f64, max_rad: f64 },
@@ -122,6 +123,20 @@ impl Joint {
         })
     }
 
+    /// Unit direction of the bone that leaves this joint in the rest pose
+    /// (the same for every body's proportions): the axis of the joint's
+    /// twist in joint space.
+    pub fn rest_bone_axis(self) -> DVec3 {
+        use Joint::*;
+        match self {
+            Pelvis | Spine | Chest | Neck | Head => DVec3::Y,
+            LeftShoulder | LeftElbow | LeftWrist => DVec3::X,
+            RightShoulder | RightElbow | RightWrist => DVec3::NEG_X,
+            LeftHip | LeftKnee | RightHip | RightKnee => DVec3::NEG_Y,
+            LeftAnkle | RightAnkle => DVec3::new(0.0, -FOOT_DROP, FOOT_REACH).normalize(),
+        }
+    }
+
     /// The joint the bone from this joint leads to; `None` for the joints
     /// whose bone ends at an end site (head, wrists, ankles).
     pub fn bone_child(self) -> Option<Joint> {
@@ -163,6 +178,10 @@ impl Joint {
             LeftHip | RightHip => ball(130.0),
             LeftAnkle | RightAnkle => ball(50.0),
         }
+    }
+
+    pub fn is_knee(self) -> bool {
+        matches!(self, Joint::LeftKnee | Joint::RightKnee)
     }
 
     pub fn is_hinge(self) -> bool {
@@ -211,6 +230,10 @@ impl Joint {
         }
     }
 }
+
+/// The toe tip below and ahead of the ankle, as shares of height.
+const FOOT_DROP: f64 = 0.030;
+const FOOT_REACH: f64 = 0.110;
 
 /// Proportions of a canonical body: its height and the scale of its limbs.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -284,7 +307,7 @@ impl Body {
         ends[LeftWrist.index()] = Some(DVec3::new(0.108 * h * arm, 0.0, 0.0));
         ends[RightWrist.index()] = Some(DVec3::new(-0.108 * h * arm, 0.0, 0.0));
         for ankle in [LeftAnkle, RightAnkle] {
-            ends[ankle.index()] = Some(DVec3::new(0.0, -0.030 * h, 0.110 * h));
+            ends[ankle.index()] = Some(DVec3::new(0.0, -FOOT_DROP * h, FOOT_REACH * h));
         }
         Body { proportions: p, offsets, ends }
     }
@@ -368,6 +391,14 @@ mod tests {
         assert!((arm(&tall_legs) - 1.1 * arm(&base)).abs() < 1e-12);
         let ankle = |b: &Body| b.pelvis_height() + b.offset(Joint::LeftHip).y - b.leg_length();
         assert!((ankle(&tall_legs) - ankle(&base)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn each_joints_twist_axis_is_its_rest_bone() {
+        let body = Body::new(Proportions { height_m: 1.6, arm_scale: 1.2, leg_scale: 0.9 });
+        for j in Joint::ALL {
+            assert!(body.bone(j).normalize().abs_diff_eq(j.rest_bone_axis(), 1e-12), "{j:?}");
+        }
     }
 
     #[test]

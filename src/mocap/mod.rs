@@ -3,7 +3,9 @@
 
 pub mod body;
 pub mod bvh;
+pub mod fidelity;
 pub mod fk;
+pub mod hinge;
 pub mod mapping;
 pub mod math;
 pub mod pose;

@@ -3,7 +3,7 @@
 
 use crate::mocap::body::{Body, DOF, JOINTS, Joint, JointVector, Kind};
 use crate::mocap::bvh::{Bvh, Channel, Joint as BvhJoint, Skeleton};
-use crate::mocap::math::{Axis, exp_map, heading_of, hinge_angle, log_map};
+use crate::mocap::math::{Axis, heading_of, hinge_angle, swing_twist_exp, swing_twist_log};
 use glam::{DQuat, DVec3};
 
 /// One pose of the canonical body: the global root kept apart from the
@@ -56,12 +56,18 @@ impl Pose {
         &self.x[o..o + j.dof()]
     }
 
+    /// The pelvis's rotation after the heading: its tilt.
+    pub fn tilt(&self) -> DQuat {
+        let v = self.joint(Joint::Pelvis);
+        swing_twist_exp(DVec3::new(v[0], v[1], v[2]), Joint::Pelvis.rest_bone_axis())
+    }
+
     /// Rotation of `j` relative to its parent (for the pelvis: in the world).
     pub fn local_rotation(&self, j: Joint) -> DQuat {
         let v = self.joint(j);
         let q = match j.kind() {
             Kind::Hinge { axis, .. } => DQuat::from_axis_angle(axis, v[0]),
-            Kind::Ball { .. } => exp_map(DVec3::new(v[0], v[1], v[2])),
+            Kind::Ball { .. } => swing_twist_exp(DVec3::new(v[0], v[1], v[2]), j.rest_bone_axis()),
         };
         if j == Joint::Pelvis { Axis::Y.rotation(self.heading) * q } else { q }
     }
@@ -81,7 +87,7 @@ impl Pose {
             let o = j.dof_offset();
             match j.kind() {
                 Kind::Hinge { axis, .. } => x[o] = hinge_angle(q, axis),
-                Kind::Ball { .. } => x[o..o + 3].copy_from_slice(&log_map(q).to_array()),
+                Kind::Ball { .. } => x[o..o + 3].copy_from_slice(&swing_twist_log(q, j.rest_bone_axis()).to_array()),
             }
         }
         Pose { root, heading, x }

@@ -6,32 +6,20 @@
 //! - pelvis, spine, chest: the hip and shoulder lines;
 //! - upper arms and thighs: the plane the limb bends in (the elbow or knee
 //!   is a hinge, so its axis is normal to that plane), which makes the
-//!   forearm and shin directions exact as well;
+//!   forearm and shin directions exact as well; a nearly straight limb's
+//!   axis is carried over the take ([`crate::mocap::hinge`]);
 //! - hands: the thumb; head, hands and feet without a second landmark: the
 //!   source joint's own frame, calibrated once per take.
-//!
-//! When a limb is nearly straight its bend plane is undefined, so the
-//! hinge axis blends smoothly toward the axis the source's own upper-arm or
-//! thigh frame carries (calibrated over the take), which keeps the twist
-//! continuous where the direction alone says nothing.
 
 use crate::mocap::body::{Body, JOINTS, Joint, Kind};
 use crate::mocap::bvh::{Bvh, Warning};
 use crate::mocap::fk::{Kinematics, PositionMode, Transform, sample_frames};
+use crate::mocap::hinge::{self, Bend};
 use crate::mocap::mapping::{Landmark, Mapping, MappingError, SourcePoint, UserMapping, joint_list, map_skeleton};
-use crate::mocap::math::{Axis, frame_from_directions, smoothstep5};
+use crate::mocap::math::{Axis, frame_from_directions};
 use crate::mocap::pose::{Motion, Pose};
-use glam::{DMat3, DQuat, DVec3};
+use glam::{DQuat, DVec3};
 use rayon::prelude::*;
-
-/// Sine of the bend (44°) above which an arm or leg's hinge axis is its
-/// bend-plane normal, so the far segment's direction is exact. Below it the
-/// axis blends into the calibrated source frame. Measured on the real
-/// captures: with 0.05 (3°), 54 frame-to-frame twist flips of 60–170° that
-/// the source does not make (carrying-angle deviations of hanging arms);
-/// with 0.7, none, for a mean limb direction error of 0.29° (worst file
-/// 1.07°).
-const STRAIGHT_SIN: f64 = 0.7;
 
 /// Plausible standing heights of a captured person, meters.
 const HEIGHT_RANGE_M: (f64, f64) = (1.3, 2.2);
@@ -157,6 +145,31 @@ const LIMBS: [Limb; 4] = [
     Limb { parent: Joint::Pelvis, root: Joint::RightHip, hinge: Joint::RightKnee, end: Joint::RightAnkle },
 ];
 
+/// Hinge axes of the four limbs, then the twists of the two hands: what
+/// is carried from frame to frame.
+const TRACKED: usize = LIMBS.len() + 2;
+
+/// The direction of limb `k`'s end (hand or foot): to its tip, else along
+/// the source end joint's own frame, calibrated.
+fn end_direction(f: &SourceFrame, cal: &Calibration, k: usize) -> Option<DVec3> {
+    let end = LIMBS[k].end;
+    let (tip, _, _) = end_landmarks(end);
+    let from_tip = f.p(tip).zip(f.pj(end)).map(|(t, c)| t - c).filter(|d| d.length() > 0.0);
+    from_tip.or_else(|| Some(f.sj(end)? * cal.end_bone[k]?))
+}
+
+/// The twist of hand `k` (0 left, 1 right): toward the thumb, else the
+/// source hand's own frame, calibrated; and whether it is a frame (which
+/// may flip half a turn between frames).
+fn end_twist(f: &SourceFrame, cal: &Calibration, k: usize) -> Option<(DVec3, bool)> {
+    let end = LIMBS[k].end;
+    let (_, thumb, _) = end_landmarks(end);
+    match thumb.and_then(|t| Some(f.p(t)? - f.pj(end)?)) {
+        Some(t) => Some((t, false)),
+        None => Some((f.sj(end)? * cal.end_twist[k]?, true)),
+    }
+}
+
 /// For the limb ends: the tip that gives their direction and the landmark
 /// that gives their twist, and the rest-pose axis that twist lies along.
 fn end_landmarks(end: Joint) -> (Landmark, Option<Landmark>, DVec3) {
@@ -274,31 +287,66 @@ impl Retargeter {
         &self.body
     }
 
-    /// Retargets every frame, in parallel.
+    /// Retargets every frame: in parallel, but for the hinge axes, which
+    /// are carried from frame to frame ([`crate::mocap::hinge`]).
     pub fn retarget(&self, bvh: &Bvh) -> Motion {
         let channels = bvh.channel_count();
-        let poses = bvh
-            .data
-            .par_chunks(channels)
-            .map_init(
-                || vec![Transform::default(); bvh.skeleton.joints.len()],
-                |scratch, frame| self.pose(frame, scratch),
-            )
-            .collect();
+        let joints = bvh.skeleton.joints.len();
+        let frames = bvh.data.par_chunks(channels);
+        let poses = if let Some(direct) = self.direct {
+            frames.map(|frame| self.direct_pose(frame, &direct)).collect()
+        } else {
+            let bends: Vec<[Option<Bend>; TRACKED]> = frames
+                .map_init(
+                    || vec![Transform::default(); joints],
+                    |scratch, frame| self.bends(&self.source_frame(frame, scratch), &self.cal),
+                )
+                .collect();
+            let axes: Vec<Vec<Option<DVec3>>> = (0..TRACKED)
+                .map(|k| {
+                    let limb: Vec<Option<Bend>> = bends.iter().map(|b| b[k]).collect();
+                    hinge::track(&limb, bvh.frame_time_s)
+                })
+                .collect();
+            bvh.data
+                .par_chunks(channels)
+                .enumerate()
+                .map_init(
+                    || vec![Transform::default(); joints],
+                    |scratch, (t, frame)| {
+                        let source = self.source_frame(frame, scratch);
+                        let world = self.solve(&source, &self.cal, std::array::from_fn(|k| axes[k][t]));
+                        let local = local_rotations(&world.rotations, &world.hinge_angles);
+                        let root = source.pj(Joint::Pelvis).unwrap_or(DVec3::ZERO) * self.scale;
+                        Pose::from_rotations(root, &local)
+                    },
+                )
+                .collect()
+        };
         Motion { body: self.body.clone(), frame_time_s: bvh.frame_time_s, poses }
     }
 
-    /// The canonical pose for one frame of channel values. `scratch` holds
-    /// one transform per source joint.
-    pub fn pose(&self, frame: &[f64], scratch: &mut [Transform]) -> Pose {
-        if let Some(direct) = self.direct {
-            return self.direct_pose(frame, &direct);
-        }
-        let source = self.source_frame(frame, scratch);
-        let world = self.solve(&source, &self.cal);
-        let local = local_rotations(&world.rotations, &world.hinge_angles);
-        let root = source.pj(Joint::Pelvis).unwrap_or(DVec3::ZERO) * self.scale;
-        Pose::from_rotations(root, &local)
+    /// How each limb bends in one source frame, with the reference axis for
+    /// when it is straight: the source's own upper-arm or thigh frame,
+    /// calibrated, else the limb's geometry.
+    ///
+    /// After the four limbs, the two hands: their direction, and the twist
+    /// about it (the thumb, else the source hand's own frame, which may
+    /// flip), carried like a straight limb's hinge axis.
+    fn bends(&self, f: &SourceFrame, cal: &Calibration) -> [Option<Bend>; TRACKED] {
+        std::array::from_fn(|k| {
+            if k >= LIMBS.len() {
+                let k = k - LIMBS.len();
+                let dir = end_direction(f, cal, k)?;
+                let (twist, may_flip) = end_twist(f, cal, k)?;
+                return Bend::new(dir, dir, Some(twist), may_flip);
+            }
+            let limb = &LIMBS[k];
+            let (a, b, c) = (f.pj(limb.root)?, f.pj(limb.hinge)?, f.pj(limb.end)?);
+            let calibrated = f.sj(limb.root).zip(cal.hinge[k]).map(|(s, h)| s * h);
+            let from_frame = calibrated.is_some();
+            Bend::new(b - a, c - b, calibrated.or_else(|| hinge_reference(f, limb, b - a)), from_frame)
+        })
     }
 
     /// Source landmark positions for one frame in the canonical world
@@ -339,8 +387,9 @@ impl Retargeter {
         Pose::from_rotations(root, &local)
     }
 
-    /// World rotations of the canonical joints for one source frame.
-    fn solve(&self, f: &SourceFrame, cal: &Calibration) -> Solved {
+    /// World rotations of the canonical joints for one source frame, with
+    /// each limb's hinge axis and each hand's twist (as [`Self::bends`]).
+    fn solve(&self, f: &SourceFrame, cal: &Calibration, axes: [Option<DVec3>; TRACKED]) -> Solved {
         use Joint::*;
         let mut w = [DQuat::IDENTITY; JOINTS];
         let mut hinge_angles = [0.0; JOINTS];
@@ -382,8 +431,7 @@ impl Retargeter {
                 continue;
             };
             let (u, v) = (b - a, c - b);
-            let calibrated = f.sj(limb.root).zip(cal.hinge[k]).map(|(s, h)| s * h);
-            let axis = hinge_axis(u, v, calibrated).unwrap_or(parent * rest_axis);
+            let axis = axes[k].unwrap_or(parent * rest_axis);
             let root = orient(bone, rest_axis, Some(u), axis, parent);
             let angle = signed_angle(u, v, root * rest_axis);
             w[limb.root.index()] = root;
@@ -391,15 +439,11 @@ impl Retargeter {
             let hinge = root * DQuat::from_axis_angle(rest_axis, angle);
             w[limb.hinge.index()] = hinge;
 
-            let (tip, twist_landmark, rest_twist) = end_landmarks(limb.end);
-            let s_end = f.sj(limb.end);
-            let dir = f.p(tip).map(|t| t - c).filter(|d| d.length() > 0.0).or_else(|| Some(s_end? * cal.end_bone[k]?));
-            let twist = twist_landmark
-                .and_then(|l| f.p(l))
-                .map(|t| t - c)
-                .or_else(|| Some(s_end? * cal.end_twist[k]?))
-                .unwrap_or(hinge * rest_twist);
-            w[limb.end.index()] = orient(self.body.bone(limb.end), rest_twist, dir, twist, hinge);
+            let (_, _, rest_twist) = end_landmarks(limb.end);
+            // A foot turns about the shin by little, and source foot frames
+            // flip: its twist is the shin's.
+            let twist = axes.get(LIMBS.len() + k).copied().flatten().unwrap_or(hinge * rest_twist);
+            w[limb.end.index()] = orient(self.body.bone(limb.end), rest_twist, end_direction(f, cal, k), twist, hinge);
         }
         Solved { rotations: w, hinge_angles }
     }
@@ -522,21 +566,32 @@ impl Retargeter {
     /// The source-frame directions that stand in for missing landmarks and
     /// for the bend plane of straight limbs, from upright sampled frames.
     fn calibrate(&self, frames: &[SourceFrame]) -> Calibration {
-        // Hinge axes: the line the bend-plane normals (seen from the limb
-        // root's frame, weighted by how clearly the limb is bent) cluster
-        // on. A plain mean would cancel between frames that flex and frames
-        // that bend slightly past straight, so take the dominant axis of
-        // their scatter and point it the way most of them bend.
+        // Hinge axes, seen from the limb root's frame: the line the
+        // bend-plane normals of clearly bent frames cluster on (their
+        // dominant axis, pointed the way most of them bend), when the take
+        // bends the limb often enough; else, and for the sign of a knee
+        // always, the limb's own geometry (`hinge_reference`). Slight bends
+        // are noise: a take that hardly bends its knees once turned a
+        // thigh by 90° on them.
         let mut cal = Calibration::default();
         for (k, limb) in LIMBS.iter().enumerate() {
-            let normals: Vec<DVec3> = frames
-                .iter()
-                .filter_map(|f| {
-                    let (a, b, c, s) = (f.pj(limb.root)?, f.pj(limb.hinge)?, f.pj(limb.end)?, f.sj(limb.root)?);
-                    Some(s.inverse() * (b - a).normalize_or_zero().cross((c - b).normalize_or_zero()))
-                })
-                .collect();
-            cal.hinge[k] = dominant_axis(&normals);
+            let mut bent = Vec::new();
+            let mut reference = DVec3::ZERO;
+            for f in frames {
+                let (Some(a), Some(b), Some(c), Some(s)) =
+                    (f.pj(limb.root), f.pj(limb.hinge), f.pj(limb.end), f.sj(limb.root))
+                else {
+                    continue;
+                };
+                let normal = (b - a).normalize_or_zero().cross((c - b).normalize_or_zero());
+                if normal.length() >= hinge::CALIBRATION_BEND_SIN {
+                    bent.push(s.inverse() * normal);
+                }
+                if let Some(r) = hinge_reference(f, limb, b - a) {
+                    reference += s.inverse() * r;
+                }
+            }
+            cal.hinge[k] = hinge::calibrate(&bent, reference, frames.len(), limb.hinge.is_knee());
         }
 
         // Ends: where the solved parent frame puts the rest bone and twist
@@ -545,7 +600,8 @@ impl Retargeter {
         let mut bone_sum = [DVec3::ZERO; 5];
         let mut twist_sum = [DVec3::ZERO; 5];
         for f in frames {
-            let solved = self.solve(f, &cal);
+            let axes = self.bends(f, &cal).map(|b| b.and_then(|b| b.axis()));
+            let solved = self.solve(f, &cal, axes);
             let ends = [
                 (Joint::LeftWrist, Joint::LeftElbow, DVec3::Z),
                 (Joint::RightWrist, Joint::RightElbow, DVec3::Z),
@@ -570,27 +626,30 @@ impl Retargeter {
     }
 }
 
-/// The unit axis along which `vectors` spread most (the top eigenvector of
-/// Σ v vᵀ, by power iteration), signed to agree with most of them
-/// (weighted by length). `None` when they are all zero.
-fn dominant_axis(vectors: &[DVec3]) -> Option<DVec3> {
-    let scatter = vectors.iter().fold(DMat3::ZERO, |m, v| m + DMat3::from_cols(*v * v.x, *v * v.y, *v * v.z));
-    // Start from the column with the most weight: never orthogonal to the
-    // top eigenvector unless the scatter is zero.
-    let mut axis = [scatter.x_axis, scatter.y_axis, scatter.z_axis]
-        .into_iter()
-        .max_by(|a, b| a.length_squared().total_cmp(&b.length_squared()))?
-        .try_normalize()?;
-    for _ in 0..100 {
-        let next = (scatter * axis).try_normalize()?;
-        let converged = next.dot(axis) > 1.0 - 1e-15;
-        axis = next;
-        if converged {
-            break;
-        }
+/// The hinge axis a limb's own geometry gives in one frame, perpendicular
+/// to the upper segment `upper`: for a knee, the hip line (to the person's
+/// left, as the canonical knee's +X), turned toward the line across the
+/// foot where the foot points away from the thigh; for an elbow, the axis
+/// about which the forearm swings forward (toward where the chest faces),
+/// or up where the arm points forward. `None` where the landmarks are
+/// missing or the directions degenerate.
+fn hinge_reference(f: &SourceFrame, limb: &Limb, upper: DVec3) -> Option<DVec3> {
+    use Joint::*;
+    let u = upper.try_normalize()?;
+    let across = |v: DVec3| (v - u * v.dot(u)).try_normalize();
+    let lateral = |left: Joint, right: Joint| Some(f.pj(left)? - f.pj(right)?);
+    if limb.hinge.is_knee() {
+        let hips = across(lateral(LeftHip, RightHip)?)?;
+        let toe = if limb.end == LeftAnkle { Landmark::LeftToe } else { Landmark::RightToe };
+        // The foot counts as much as it points away from the thigh.
+        let foot = f.p(toe).zip(f.pj(limb.end)).map(|(t, a)| (t - a).normalize_or_zero().cross(u)).unwrap_or(hips);
+        return across(hips + foot);
     }
-    let agreement: f64 = vectors.iter().map(|v| v.dot(axis)).sum();
-    Some(if agreement < 0.0 { -axis } else { axis })
+    let left = lateral(LeftShoulder, RightShoulder)?;
+    let up = f.pj(Neck)? - f.pj(Chest)?;
+    let forward = left.cross(up);
+    let swing = across(forward).filter(|_| forward.normalize_or_zero().dot(u).abs() < 0.9).or_else(|| across(up))?;
+    u.cross(swing).try_normalize()
 }
 
 struct Solved {
@@ -616,44 +675,6 @@ fn orient(
             frame_from_directions(rest_primary, rest_secondary, p, parent * rest_secondary)
         })
         .unwrap_or(parent)
-}
-
-/// The hinge axis for a limb with segments `u` then `v`.
-///
-/// The bend-plane normal `e` makes the far segment's direction exact, but
-/// it is noise when the limb is nearly straight, and it is ambiguous in
-/// sign: a forearm can reach the same direction by flexing or by bending
-/// past straight with the upper arm turned half a revolution. Real elbows
-/// are not pure hinges either: a hanging arm's forearm deviates sideways
-/// by the carrying angle, across the flexion plane. So the axis is
-///
-/// `n ∝ w·(e·f)·e + (1 − w)·f`,
-///
-/// with `f` the calibrated axis (from the source's own limb frame) made
-/// perpendicular to `u` and `w` rising smoothly from 0 (straight) to 1
-/// (clearly bent). It depends on `e` only through `(e·f)·e`, which is the
-/// same for `−e`, so it is continuous in the pose; it leans toward `f`
-/// exactly when the bend plane disagrees with it; and it follows `e`
-/// whenever the limb is clearly bent and the two agree at all.
-fn hinge_axis(u: DVec3, v: DVec3, calibrated: Option<DVec3>) -> Option<DVec3> {
-    let (un, vn) = (u.try_normalize()?, v.try_normalize()?);
-    let cross = un.cross(vn);
-    let sin = cross.length();
-    let fallback = calibrated.and_then(|c| (c - un * c.dot(un)).try_normalize());
-    let Some(fallback) = fallback else {
-        return cross.try_normalize();
-    };
-    if sin < 1e-12 {
-        return Some(fallback);
-    }
-    let exact = cross / sin;
-    let agreement = exact.dot(fallback);
-    let w = smoothstep5(sin / STRAIGHT_SIN);
-    (exact * (w * agreement) + fallback * (1.0 - w)).try_normalize().or(Some(if agreement < 0.0 {
-        -exact
-    } else {
-        exact
-    }))
 }
 
 /// Angle from `u` to `v` about `axis` (right-handed), in (−π, π].
@@ -818,62 +839,4 @@ fn canonical_joints(bvh: &Bvh, body: &Body, up: DQuat) -> Option<[usize; JOINTS]
         }
     }
     Some(map)
-}
-
-/// How closely a retargeted motion follows its source: the angle between
-/// each canonical limb bone and the source bone, per frame.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct DirectionErrors {
-    /// Mean over frames for the upper arms, forearms, thighs and shins, in
-    /// the order of [`DirectionErrors::BONES`], degrees.
-    pub per_bone_deg: Vec<(&'static str, f64)>,
-    /// Mean over frames and bones, degrees.
-    pub mean_deg: f64,
-    /// Largest single-frame error, degrees.
-    pub max_deg: f64,
-}
-
-impl DirectionErrors {
-    pub const BONES: [(&'static str, Joint, Joint); 8] = [
-        ("left upper arm", Joint::LeftShoulder, Joint::LeftElbow),
-        ("left forearm", Joint::LeftElbow, Joint::LeftWrist),
-        ("right upper arm", Joint::RightShoulder, Joint::RightElbow),
-        ("right forearm", Joint::RightElbow, Joint::RightWrist),
-        ("left thigh", Joint::LeftHip, Joint::LeftKnee),
-        ("left shin", Joint::LeftKnee, Joint::LeftAnkle),
-        ("right thigh", Joint::RightHip, Joint::RightKnee),
-        ("right shin", Joint::RightKnee, Joint::RightAnkle),
-    ];
-
-    /// Compares `motion` (retargeted from `bvh` by `retargeter`) with the
-    /// source bones, over the bones both have.
-    pub fn measure(bvh: &Bvh, retargeter: &Retargeter, motion: &Motion) -> DirectionErrors {
-        let mut scratch = vec![Transform::default(); bvh.skeleton.joints.len()];
-        let mut sums = [0.0; 8];
-        let mut counts = [0usize; 8];
-        let mut max_deg: f64 = 0.0;
-        for (f, pose) in motion.poses.iter().enumerate() {
-            let source = retargeter.source_landmarks(bvh.frame(f), &mut scratch);
-            let canon = motion.body.forward(pose);
-            for (b, (_, from, to)) in DirectionErrors::BONES.iter().enumerate() {
-                let (Some(sa), Some(sb)) = (source[from.index()], source[to.index()]) else {
-                    continue;
-                };
-                let d_source = (sb - sa).normalize_or_zero();
-                let d_canon = (canon.position(*to) - canon.position(*from)).normalize_or_zero();
-                let deg = d_source.dot(d_canon).clamp(-1.0, 1.0).acos().to_degrees();
-                sums[b] += deg;
-                counts[b] += 1;
-                max_deg = max_deg.max(deg);
-            }
-        }
-        let per_bone_deg: Vec<(&'static str, f64)> = DirectionErrors::BONES
-            .iter()
-            .enumerate()
-            .filter(|(b, _)| counts[*b] > 0)
-            .map(|(b, (name, _, _))| (*name, sums[b] / counts[b] as f64))
-            .collect();
-        let mean_deg = per_bone_deg.iter().map(|(_, d)| d).sum::<f64>() / per_bone_deg.len().max(1) as f64;
-        DirectionErrors { per_bone_deg, mean_deg, max_deg }
-    }
 }

@@ -7,7 +7,7 @@ use super::humanoid::{Base, Gains, Humanoid};
 use super::targets::{JointTarget, Targets, TargetsError, motorized};
 use crate::fsutil::{round6, rounded};
 use crate::mocap::body::{JOINTS, Joint, Kind};
-use crate::mocap::math::{angle_between, exp_map};
+use crate::mocap::math::angle_between;
 use crate::mocap::pose::{Motion, Pose};
 use glam::{DQuat, DVec3};
 use std::fmt::Write;
@@ -193,9 +193,8 @@ pub fn execute(
     let mut record = |k: usize, humanoid: &Humanoid, torque: [DVec3; JOINTS]| {
         let achieved = humanoid.pose();
         let asked = targets.pose(k);
-        let tilt = |p: &Pose| exp_map(DVec3::from_slice(p.joint(Joint::Pelvis)));
         let mut error_rad = Joint::ALL.map(|j| angle_between(asked.local_rotation(j), achieved.local_rotation(j)));
-        error_rad[Joint::Pelvis.index()] = angle_between(tilt(asked), tilt(&achieved));
+        error_rad[Joint::Pelvis.index()] = angle_between(asked.tilt(), achieved.tilt());
         frames.push(ExecutedFrame { time_s: k as f64 * frame_time, achieved, torque, error_rad });
     };
     record(0, &humanoid, torque);

@@ -13,9 +13,9 @@ pub fn position_columns() -> Vec<String> {
     Joint::ALL.iter().flat_map(|j| ["x", "y", "z"].map(|a| format!("{}_{a}", j.name()))).collect()
 }
 
-/// The joint angles, radians: `<joint>_rx`, `_ry`, `_rz` (the exponential
-/// map of a ball joint's rotation relative to its parent and the rest pose,
-/// the pelvis's after the heading) or `<joint>_angle` for a hinge.
+/// The joint angles, radians: `<joint>_rx`, `_ry`, `_rz` (the swing–twist
+/// coordinates of a ball joint's rotation relative to its parent and the
+/// rest pose, the pelvis's after the heading) or `<joint>_angle` for a hinge.
 pub fn angle_columns() -> Vec<String> {
     Joint::ALL
         .iter()

@@ -78,7 +78,8 @@ use crate::fsutil::write_atomic;
 pub const MAGIC: &[u8; 14] = b"imitate-vocab\n";
 
 /// The format version this code writes, and the newest it reads.
-pub const FORMAT_VERSION: u32 = 1;
+/// 2: poses in swing–twist joint space (1: exponential maps).
+pub const FORMAT_VERSION: u32 = 2;
 
 /// The header key holding the list of arrays, added by the container.
 pub const ARRAYS_KEY: &str = "arrays";
@@ -304,6 +305,9 @@ fn decode(bytes: &[u8]) -> Result<Container, ContainerErrorKind> {
     if version > FORMAT_VERSION {
         return Err(ContainerErrorKind::NewerVersion { version });
     }
+    if version == 1 {
+        return Err(ContainerErrorKind::OlderJointSpace { version });
+    }
     if version != FORMAT_VERSION {
         return Err(ContainerErrorKind::UnknownVersion { version });
     }
@@ -479,6 +483,11 @@ pub enum ContainerErrorKind {
     )]
     NewerVersion { version: u32 },
     #[error(
+        "format version {version}, whose poses are in an earlier joint space (exponential maps; this version reads \
+         format {FORMAT_VERSION}, swing–twist): build the vocabulary again with `imitate vocab build`"
+    )]
+    OlderJointSpace { version: u32 },
+    #[error(
         "unknown format version {version} (this version reads {FORMAT_VERSION}, and no imitate wrote \
          {version}): the file is damaged"
     )]
@@ -636,7 +645,7 @@ mod tests {
         let bytes = c.to_bytes().unwrap();
         let header = br#"{"arrays":[{"len":2,"name":"mean"}],"data_bytes":16,"kind":"demo"}"#;
         let mut expected = b"imitate-vocab\n".to_vec();
-        expected.extend_from_slice(&[1, 0, 0, 0]);
+        expected.extend_from_slice(&[2, 0, 0, 0]);
         expected.extend_from_slice(&(header.len() as u64).to_le_bytes());
         expected.extend_from_slice(header);
         // 26 + 66 = 92 bytes so far: 4 zero bytes pad the data to offset 96.
@@ -824,22 +833,32 @@ mod tests {
         bytes[VERSION_AT..HEADER_LEN_AT].copy_from_slice(&3u32.to_le_bytes());
         reseal(&mut bytes);
         let kind =
-            refused(&bytes, "written by a newer imitate (format version 3; this version reads 1): update imitate");
+            refused(&bytes, "written by a newer imitate (format version 3; this version reads 2): update imitate");
         assert!(matches!(kind, ContainerErrorKind::NewerVersion { version: 3 }));
 
         bytes[VERSION_AT..HEADER_LEN_AT].copy_from_slice(&0u32.to_le_bytes());
         reseal(&mut bytes);
-        let kind = refused(&bytes, "unknown format version 0 (this version reads 1");
+        let kind = refused(&bytes, "unknown format version 0 (this version reads 2");
         assert!(matches!(kind, ContainerErrorKind::UnknownVersion { version: 0 }));
+    }
+
+    #[test]
+    fn a_vocabulary_of_the_earlier_joint_space_asks_to_be_built_again() {
+        let mut bytes = sample().to_bytes().unwrap();
+        bytes[VERSION_AT..HEADER_LEN_AT].copy_from_slice(&1u32.to_le_bytes());
+        reseal(&mut bytes);
+        let kind = refused(&bytes, "format version 1, whose poses are in an earlier joint space");
+        assert!(matches!(kind, ContainerErrorKind::OlderJointSpace { version: 1 }), "{kind}");
+        assert!(kind.to_string().contains("imitate vocab build"), "{kind}");
     }
 
     #[test]
     fn newer_version_is_reported_even_if_the_rest_is_unreadable() {
         // A newer format may change everything after the version.
         let mut bytes = MAGIC.to_vec();
-        bytes.extend_from_slice(&2u32.to_le_bytes());
-        bytes.extend_from_slice(b"whatever version 2 holds");
-        assert!(matches!(refused(&bytes, "newer imitate"), ContainerErrorKind::NewerVersion { version: 2 }));
+        bytes.extend_from_slice(&3u32.to_le_bytes());
+        bytes.extend_from_slice(b"whatever version 3 holds");
+        assert!(matches!(refused(&bytes, "newer imitate"), ContainerErrorKind::NewerVersion { version: 3 }));
     }
 
     #[test]
@@ -883,6 +902,7 @@ mod tests {
                     _ if at < HEADER_LEN_AT => {
                         match u32::from_le_bytes(changed[VERSION_AT..HEADER_LEN_AT].try_into().unwrap()) {
                             0 => matches!(kind, ContainerErrorKind::UnknownVersion { version: 0 }),
+                            1 => matches!(kind, ContainerErrorKind::OlderJointSpace { version: 1 }),
                             v => matches!(kind, ContainerErrorKind::NewerVersion { version } if version == v),
                         }
                     }
@@ -1053,6 +1073,7 @@ mod tests {
                 ContainerErrorKind::NotVocab { .. } => "not a vocabulary file",
                 ContainerErrorKind::NewerVersion { .. } => "newer",
                 ContainerErrorKind::UnknownVersion { .. } => "unknown version",
+                ContainerErrorKind::OlderJointSpace { .. } => "older joint space",
                 ContainerErrorKind::Truncated { .. } => "truncated",
                 ContainerErrorKind::Corrupt { .. } => "corrupt",
                 ContainerErrorKind::BadHeader { .. } => "bad header",

@@ -6,7 +6,7 @@ use crate::mocap::bvh::{BvhError, read_bvh};
 use crate::mocap::pose::Motion;
 use crate::mocap::retarget::{RetargetError, RetargetOptions, Retargeter};
 use rayon::prelude::*;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// One motion file (a take), retargeted.
@@ -163,6 +163,37 @@ fn file_name(path: &str) -> String {
     Path::new(path).file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| path.to_string())
 }
 
+/// Files a labels file names that are not there: not among the inputs,
+/// nor beside the labels file or any input (a labels file may cover more
+/// takes of a folder than one build reads). A typo or a take gone missing
+/// would otherwise leave an activity silently unlabelled.
+fn missing_labelled_files(labels: &Labels, labels_path: &str, files: &[PathBuf]) -> Result<(), CorpusError> {
+    let named: Vec<&String> = match labels {
+        Labels::PerFile(map) => map.keys().collect(),
+        Labels::PerFileFrame(map) => map.keys().collect(),
+        Labels::PerFrame(_) => return Ok(()),
+    };
+    let inputs: BTreeSet<String> = files.iter().map(|f| file_name(&f.to_string_lossy())).collect();
+    let folders: BTreeSet<&Path> =
+        files.iter().filter_map(|f| f.parent()).chain(Path::new(labels_path).parent()).collect();
+    let there = |name: &str| inputs.contains(name) || folders.iter().any(|d| d.join(name).is_file());
+    let missing: Vec<&str> = named.into_iter().map(String::as_str).filter(|n| !there(n)).collect();
+    if missing.is_empty() {
+        return Ok(());
+    }
+    const LISTED: usize = 5;
+    let mut list = missing[..missing.len().min(LISTED)].join(", ");
+    if missing.len() > LISTED {
+        list += &format!(" and {} more", missing.len() - LISTED);
+    }
+    let problem = format!(
+        "names {} file{} neither among the inputs nor beside them: {list}",
+        missing.len(),
+        if missing.len() == 1 { "" } else { "s" }
+    );
+    Err(CorpusError::BadLabels { path: labels_path.to_string(), problem })
+}
+
 /// A take's frame labels, which must be one per frame.
 fn per_frame<'a>(
     labels: &'a [String],
@@ -184,6 +215,9 @@ pub fn load(
     labels: Option<(&Labels, &str)>,
 ) -> Result<Corpus, CorpusError> {
     let files = expand_inputs(inputs)?;
+    if let Some((labels, labels_path)) = labels {
+        missing_labelled_files(labels, labels_path, &files)?;
+    }
     let motions: Vec<Motion> = files
         .par_iter()
         .map(|path| {

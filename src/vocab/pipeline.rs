@@ -3,7 +3,7 @@
 
 use crate::mocap::body::DOF;
 use crate::vocab::cluster::{ClusterError, Clustering, ValidClusterParams};
-use crate::vocab::corpus::Corpus;
+use crate::vocab::corpus::{Corpus, Recording};
 use crate::vocab::embed::{EmbedError, Embedding, ValidEmbedParams, resample};
 use crate::vocab::metrics::majority_labels;
 use crate::vocab::phase::PhaseAxes;
@@ -31,8 +31,10 @@ pub struct SegmentRow {
 pub enum BuildError {
     #[error("no segments: every take is shorter than the minimum segment length ({min_s} s)")]
     NoSegments { min_s: f64 },
-    #[error("every pose of every take is the same: there is no motion to learn from")]
-    Motionless,
+    #[error("{path}: every frame is the same pose: there is no motion to learn from (leave the take out)")]
+    Motionless { path: String },
+    #[error("every primitive's segments hold one pose each: there is no motion to learn from")]
+    StillPrimitives,
     #[error(transparent)]
     Embed(#[from] EmbedError),
     #[error(transparent)]
@@ -54,9 +56,11 @@ pub fn segment_corpus_along(
     params: &ValidSegmentParams,
     axes: &PhaseAxes,
 ) -> Result<Vec<SegmentRow>, BuildError> {
-    let moving = corpus.takes.iter().any(|t| t.motion.poses.windows(2).any(|w| w[0].x != w[1].x));
-    if !moving {
-        return Err(BuildError::Motionless);
+    // A still take is no short one: the file is wrong (a rest pose
+    // exported as a take), and a user who gave it should hear so.
+    let still = |t: &&Recording| t.motion.poses.len() > 1 && t.motion.poses.windows(2).all(|w| w[0] == w[1]);
+    if let Some(take) = corpus.takes.iter().find(still) {
+        return Err(BuildError::Motionless { path: take.path.clone() });
     }
     let per_take: Vec<Vec<Cut>> = corpus.takes.par_iter().map(|t| segment_motion(params, &t.motion)).collect();
     let mut rows = Vec::new();
@@ -242,7 +246,7 @@ pub fn fit_primitives(
         }
     }
     if fitted.primitives.is_empty() {
-        return Err(BuildError::Motionless);
+        return Err(BuildError::StillPrimitives);
     }
     Ok(fitted)
 }

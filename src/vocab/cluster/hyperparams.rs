@@ -41,8 +41,12 @@ fn default_min_size() -> usize {
     2
 }
 
+/// 1.5 rather than 1: on the real captures (`real/`) the silhouette of
+/// k = 11 to 18 agree within 1.5 standard errors and the larger k gives
+/// purity 0.83 against 0.75; on `bandai` and the synthetic corpus it
+/// chooses the same k as 1 does.
 fn default_tolerance() -> f64 {
-    1.0
+    1.5
 }
 
 /// Settings that passed [`ClusterParams::check`].
