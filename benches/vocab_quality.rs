@@ -1,4 +1,4 @@
-//! The vocabulary figures the README reports, as Markdown tables:
+//! The vocabulary figures docs/numbers.md reports, as Markdown tables:
 //!
 //! 1. the synthetic stream (circles, horizontal and vertical
 //!    waving, punching; 4 repetitions each at 0.5×, 1× and 2×), five seeds:

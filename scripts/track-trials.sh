@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The tracker's quality figures (README, "Tracking: measured"): builds a
+# The tracker's quality figures (docs/numbers.md, "Tracking"): builds a
 # vocabulary of the paper's four activities from synthetic takes, renders
 # held-out sequences (another seed), tracks and scores them, and prints one
 # table per trial. Real captures are used when ../shared/mocap/real (or

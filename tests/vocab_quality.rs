@@ -1,4 +1,4 @@
-//! What a learned vocabulary is worth, measured as the README reports it:
+//! What a learned vocabulary is worth, measured as docs/numbers.md reports it:
 //! clusters against activity labels (never seen by learning), and each
 //! primitive's gradient field and progress on held-out repetitions.
 

@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 /// (or takes --vocab), renders held-out sequences, tracks and scores them,
 /// and writes DIR/index.html (self-contained), each trial's table as CSV
 /// and chart as PNG and SVG, filmstrips, metrics.json and timing.json (see
-/// the README).
+/// docs/formats.md).
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The report's folder (refused if it holds something, unless --force).

@@ -20,7 +20,7 @@ use std::time::Instant;
 ///
 /// Any BVH goes in (it is retargeted first): `track`'s trajectory.bvh,
 /// `synth` output, motion capture. Writes DIR/executed.bvh,
-/// DIR/execution.csv and DIR/summary.json (see the README).
+/// DIR/execution.csv and DIR/summary.json (see docs/formats.md).
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The trajectory: a BVH file.

@@ -6,8 +6,8 @@ use imitate::vocab::stages::read_primitives;
 use std::path::PathBuf;
 
 /// Pack a primitives folder (from `imitate fit`) into one versioned,
-/// self-describing `.vocab` file guarded by a checksum (format in the
-/// README).
+/// self-describing `.vocab` file guarded by a checksum (format in
+/// docs/formats.md).
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// A primitives folder from `imitate fit`.

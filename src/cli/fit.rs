@@ -17,7 +17,7 @@ use std::path::PathBuf;
 /// along each training segment).
 ///
 /// Writes a folder: `index.json` and, per primitive, its latent space and
-/// field as Parquet tables (see the README). Reads the motion again from
+/// field as Parquet tables (see docs/formats.md). Reads the motion again from
 /// the files the table names.
 #[derive(Debug, clap::Args)]
 pub struct Args {

@@ -23,7 +23,7 @@ use std::time::Instant;
 ///
 /// Writes DIR/frames/000000.png … (0 outside the body, 255 on it; noisy
 /// unless --noise none), DIR/camera.json and DIR/truth.csv, and with
-/// --color DIR/color/000000.png … and DIR/background.png (see the README).
+/// --color DIR/color/000000.png … and DIR/background.png (see docs/formats.md).
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The BVH file to render.

@@ -15,7 +15,7 @@ use std::path::PathBuf;
 ///
 /// Reads RUN_DIR/frames.csv and RUN_DIR/summary.json (as `imitate track`
 /// writes them) and the truth.csv `imitate render` wrote with the video,
-/// matched row by row; writes metrics.json (see the README).
+/// matched row by row; writes metrics.json (see docs/formats.md).
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The tracking run's folder.

@@ -29,7 +29,7 @@ use std::time::Instant;
 /// virtual trajectory (the winning primitive's pose each frame).
 ///
 /// Writes DIR/trajectory.bvh, DIR/frames.csv, DIR/likelihoods.csv (not
-/// with --baseline) and DIR/summary.json (see the README).
+/// with --baseline) and DIR/summary.json (see docs/formats.md).
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The frames: a folder of PNG or JPEG images (silhouettes or color),

@@ -41,7 +41,7 @@ pub struct AnnealParams {
 impl AnnealParams {
     /// Settings that spend `budget` likelihood evaluations per frame. The
     /// diffusion is the best of a grid (0.03, 0.07, 0.15 rad × 0.01, 0.03
-    /// m) on the README's three-activity sequence: wider steps lose the
+    /// m) on the documented three-activity sequence: wider steps lose the
     /// arms in 43 dimensions.
     pub fn with_budget(budget: usize) -> AnnealParams {
         const LAYERS: usize = 5;

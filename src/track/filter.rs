@@ -35,7 +35,7 @@ pub struct FilterParams {
 }
 
 impl FilterParams {
-    /// The settings `imitate track` uses, tuned on the README's
+    /// The settings `imitate track` uses, tuned on the documented
     /// three-activity sequence: noise across the cone half a frame's typical
     /// step, R^8, a manifold prior two steps wide, 5% renewal, and 4 root
     /// steps of 3 cm and 0.005 rad a frame.

@@ -15,7 +15,7 @@ use std::path::Path;
 /// meets, small enough that a mistyped size cannot exhaust memory.
 pub const MAX_SIDE: u32 = 8192;
 
-/// A camera as `camera.json` holds it (documented in the README).
+/// A camera as `camera.json` holds it (see docs/formats.md).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraSpec {

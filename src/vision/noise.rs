@@ -43,7 +43,7 @@ impl Level {
         }
     }
 
-    /// What the level does (the README's table).
+    /// What the level does (docs/commands.md has the table).
     pub fn params(self) -> Params {
         let occlusion = |every_s, duration_s, size_m| Some(Occlusions { every_s, duration_s, size_m });
         match self {
