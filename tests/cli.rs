@@ -130,6 +130,10 @@ fn retarget_writes_canonical_bvh_and_reports_how_closely_it_follows_the_source()
     assert!(out.status.success(), "{}", stderr_of(&out));
     let err = stderr_of(&out);
     assert!(err.contains("339 frames") && err.contains("limb directions match the source within"), "{err}");
+    // And how the twists hold: what the fidelity tests check in
+    // tests/retarget.rs, reported for the user's own take.
+    assert!(err.contains("standing thighs face the pelvis's way within 30° in "), "{err}");
+    assert!(err.contains("over 60° the source's bones do not make (largest jump"), "{err}");
     assert!(err.contains("warning: the capture stands along +Z"), "{err}");
     let bvh = imitate::mocap::bvh::read_bvh(&output).unwrap();
     let names: Vec<&str> = bvh.skeleton.joints.iter().map(|j| j.name.as_str()).collect();

@@ -477,3 +477,55 @@ fn a_canonical_take_exported_z_up_with_positions_on_every_joint_reads_back_exact
         }
     }
 }
+
+/// A synthetic take through BVH and back, with its retargeter.
+fn synthetic_round_trip() -> (imitate::mocap::bvh::Bvh, Retargeter, Motion) {
+    let take = activity_take(Activity::Circles, &SynthOptions { repetitions: 2, ..Default::default() }).motion;
+    let mut text = Vec::new();
+    write_bvh(&take.to_bvh(), &mut text).unwrap();
+    let bvh = read_bvh_bytes(&text, "circles.bvh").unwrap();
+    let (retargeter, motion) = retarget(&bvh);
+    (bvh, retargeter, motion)
+}
+
+/// `motion` with the left thigh twisted a quarter turn about itself in
+/// frames `frames`: the knee then faces sideways, its direction unchanged.
+fn twist_left_thigh(motion: &mut Motion, frames: std::ops::Range<usize>) {
+    let o = Joint::LeftHip.dof_offset();
+    for pose in &mut motion.poses[frames] {
+        let twisted = DVec3::from_slice(&pose.x[o..o + 3]) + Joint::LeftHip.rest_bone_axis() * 90f64.to_radians();
+        pose.x[o..o + 3].copy_from_slice(&twisted.to_array());
+    }
+}
+
+#[test]
+fn thigh_facing_counts_the_standing_frames_whose_knee_turns_away_from_the_pelvis() {
+    use imitate::mocap::fidelity::ThighFacing;
+    let (_, _, mut motion) = synthetic_round_trip();
+    let facing = ThighFacing::measure(&motion);
+    // Both legs stand in every frame of the demonstrator's circles.
+    assert_eq!(facing.standing, 2 * motion.poses.len());
+    assert_eq!(facing.beyond_30_deg, 0, "{facing:?}");
+    twist_left_thigh(&mut motion, 10..20);
+    let twisted = ThighFacing::measure(&motion);
+    assert_eq!(twisted.standing, facing.standing);
+    assert_eq!(twisted.beyond_30_deg, 10, "{twisted:?}");
+    assert!((twisted.worst_deg - 90.0).abs() < 1.0, "{twisted:?}");
+}
+
+#[test]
+fn continuity_names_joint_space_jumps_the_source_bones_do_not_make() {
+    use imitate::mocap::fidelity::{Continuity, JUMP_DEG};
+    let (bvh, retargeter, mut motion) = synthetic_round_trip();
+    let smooth = Continuity::measure(&bvh, &retargeter, &motion);
+    assert_eq!(smooth.unexplained, 0, "{smooth:?}");
+    assert!(smooth.worst_jump_deg < JUMP_DEG, "{smooth:?}");
+    // A twist in and out of frame 30: two jumps, while the source's thigh
+    // keeps its course.
+    twist_left_thigh(&mut motion, 30..31);
+    let jumped = Continuity::measure(&bvh, &retargeter, &motion);
+    assert_eq!(jumped.unexplained, 2, "{jumped:?}");
+    assert_eq!(jumped.worst_joint, Joint::LeftHip.name());
+    assert!(jumped.worst_frame == 30 || jumped.worst_frame == 31, "{jumped:?}");
+    assert!((jumped.worst_jump_deg - 90.0).abs() < 1.0, "{jumped:?}");
+}

@@ -4,7 +4,7 @@ use super::{Global, Outcome, note, progress};
 use anyhow::Context;
 use imitate::fsutil::write_atomic;
 use imitate::mocap::bvh::{read_bvh, write_bvh};
-use imitate::mocap::fidelity::DirectionErrors;
+use imitate::mocap::fidelity::{Continuity, DirectionErrors, JUMP_DEG, ThighFacing};
 use imitate::mocap::mapping::UserMapping;
 use imitate::mocap::retarget::{RetargetOptions, Retargeter, UpAxis};
 use imitate::vocab::stages::RetargetSettings;
@@ -91,6 +91,24 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             args.output.display(),
             errors.mean_deg,
             errors.max_deg
+        ),
+    );
+    let (facing, continuity) = (ThighFacing::measure(&motion), Continuity::measure(&bvh, &retargeter, &motion));
+    note(
+        global,
+        &format!(
+            "{input}: standing thighs face the pelvis's way within 30° in {} of {} leg-frames (worst {:.0}°); \
+             {} joint-space jump{} over {JUMP_DEG:.0}° the source's bones do not make (largest jump {:.0}°, {} at frame {}, \
+             where the source turned {:.0}°)",
+            facing.standing - facing.beyond_30_deg,
+            facing.standing,
+            facing.worst_deg,
+            continuity.unexplained,
+            if continuity.unexplained == 1 { "" } else { "s" },
+            continuity.worst_jump_deg,
+            continuity.worst_joint,
+            continuity.worst_frame,
+            continuity.worst_source_deg
         ),
     );
     Ok(Outcome::Success)

@@ -137,7 +137,7 @@ impl Continuity {
         let bone = |points: &[Option<DVec3>; Landmark::COUNT], j: Joint| -> Option<DVec3> {
             let far = match j.bone_child() {
                 Some(c) => points[c.index()]?,
-                None => points[end_tip(j)?.slot()]?,
+                None => points[Landmark::tip_of(j)?.slot()]?,
             };
             (far - points[j.index()]?).try_normalize()
         };
@@ -184,16 +184,4 @@ impl Continuity {
         }
         result
     }
-}
-
-/// The tip that gives a leaf joint's bone direction.
-fn end_tip(j: Joint) -> Option<Landmark> {
-    Some(match j {
-        Joint::Head => Landmark::HeadTop,
-        Joint::LeftWrist => Landmark::LeftHandTip,
-        Joint::RightWrist => Landmark::RightHandTip,
-        Joint::LeftAnkle => Landmark::LeftToe,
-        Joint::RightAnkle => Landmark::RightToe,
-        _ => return None,
-    })
 }

@@ -37,7 +37,7 @@ const MAX_TWIST_RATE: f64 = 6.3;
 pub const CALIBRATION_BEND_SIN: f64 = 0.1;
 
 /// Bent frames a take needs (of its sampled frames, at most a tenth, at
-/// least three) before its bends calibrate a hinge axis.
+/// least one) before its bends calibrate a hinge axis.
 const MIN_BENT_FRAMES: usize = 12;
 
 /// Share of the bends' weight the calibrated axis must carry.
@@ -79,60 +79,68 @@ impl Bend {
     }
 }
 
-/// The hinge axis of each frame of one limb, carried from frame to frame
-/// (see the module's documentation); `None` where the frame has no limb.
-pub fn track(bends: &[Option<Bend>], frame_time_s: f64) -> Vec<Option<DVec3>> {
-    let straight_step = MAX_TWIST_RATE * frame_time_s;
-    let mut carried: Option<(DVec3, DVec3)> = None;
-    let mut reference = Unflipped::default();
-    bends
-        .iter()
-        .map(|bend| {
-            let Some(bend) = bend else {
-                carried = None;
-                reference = Unflipped::default();
-                return None;
-            };
-            let unflipped =
-                bend.reference.map(|r| if bend.reference_may_flip { reference.next(r, bend.upper) } else { r });
-            let Some((axis, upper)) = carried else {
-                let axis = bend.axis();
-                carried = axis.map(|a| (a, bend.upper));
-                return axis;
-            };
-            let u = bend.upper;
-            // Carry the axis along as the upper segment swings.
-            let moved = DQuat::from_rotation_arc(upper, u) * axis;
-            let moved = (moved - u * moved.dot(u)).try_normalize().unwrap_or(axis);
-            // The bend plane counts the more the limb bends (fully from 44°,
-            // where the far segment's direction is exact), the reference the
-            // rest. Which way the limb bends: a slight bend keeps the
-            // carried twist (hyperextended a little, or capture noise); a
-            // clear one (20°) goes the reference's way; a deep one is a
-            // flexion, and a twist that said otherwise was wrong.
-            let side = if bend.sin < CLEAR_BEND_SIN { moved } else { unflipped.unwrap_or(moved) };
-            let weight = smoothstep5(bend.sin / EXACT_BEND_SIN);
-            let target = match bend.normal {
-                Some(n) => {
-                    let n = if n.dot(side) < 0.0 && bend.sin < EXACT_BEND_SIN { -n } else { n };
-                    (n * weight + unflipped.unwrap_or(n) * (1.0 - weight)).try_normalize().or(Some(n))
-                }
-                None => unflipped,
-            };
-            let next = match target {
-                Some(target) => {
-                    // Only a steady bend plane turns the axis faster than a
-                    // twist.
-                    let clear = smoothstep5((bend.sin - STEADY_BEND_SIN) / (CLEAR_BEND_SIN - STEADY_BEND_SIN));
-                    let step = straight_step + clear * (std::f64::consts::PI - straight_step);
-                    turn_toward(moved, target, u, step)
-                }
-                None => moved,
-            };
-            carried = Some((next, u));
-            Some(next)
-        })
-        .collect()
+/// Carries one limb's hinge axis from frame to frame (see the module's
+/// documentation), a frame at a time, so a long take can be solved in
+/// pieces.
+pub struct Tracker {
+    straight_step: f64,
+    /// The last axis and the upper segment it was perpendicular to.
+    carried: Option<(DVec3, DVec3)>,
+    reference: Unflipped,
+}
+
+impl Tracker {
+    pub fn new(frame_time_s: f64) -> Tracker {
+        Tracker { straight_step: MAX_TWIST_RATE * frame_time_s, carried: None, reference: Unflipped::default() }
+    }
+
+    /// The next frame's axis; `None` where the frame has no limb, which
+    /// also ends what is carried.
+    pub fn next(&mut self, bend: Option<&Bend>) -> Option<DVec3> {
+        let Some(bend) = bend else {
+            self.carried = None;
+            self.reference = Unflipped::default();
+            return None;
+        };
+        let unflipped =
+            bend.reference.map(|r| if bend.reference_may_flip { self.reference.next(r, bend.upper) } else { r });
+        let Some((axis, upper)) = self.carried else {
+            let axis = bend.axis();
+            self.carried = axis.map(|a| (a, bend.upper));
+            return axis;
+        };
+        let u = bend.upper;
+        // Carry the axis along as the upper segment swings.
+        let moved = DQuat::from_rotation_arc(upper, u) * axis;
+        let moved = (moved - u * moved.dot(u)).try_normalize().unwrap_or(axis);
+        // The bend plane counts the more the limb bends (fully from 44°,
+        // where the far segment's direction is exact), the reference the
+        // rest. Which way the limb bends: a slight bend keeps the carried
+        // twist (hyperextended a little, or capture noise); a clear one
+        // (20°) goes the reference's way; a deep one is a flexion, and a
+        // twist that said otherwise was wrong.
+        let side = if bend.sin < CLEAR_BEND_SIN { moved } else { unflipped.unwrap_or(moved) };
+        let weight = smoothstep5(bend.sin / EXACT_BEND_SIN);
+        let target = match bend.normal {
+            Some(n) => {
+                let n = if n.dot(side) < 0.0 && bend.sin < EXACT_BEND_SIN { -n } else { n };
+                (n * weight + unflipped.unwrap_or(n) * (1.0 - weight)).try_normalize().or(Some(n))
+            }
+            None => unflipped,
+        };
+        let next = match target {
+            Some(target) => {
+                // Only a steady bend plane turns the axis faster than a
+                // twist.
+                let clear = smoothstep5((bend.sin - STEADY_BEND_SIN) / (CLEAR_BEND_SIN - STEADY_BEND_SIN));
+                let step = self.straight_step + clear * (std::f64::consts::PI - self.straight_step);
+                turn_toward(moved, target, u, step)
+            }
+            None => moved,
+        };
+        self.carried = Some((next, u));
+        Some(next)
+    }
 }
 
 /// A reference that turns more than this (cosine of 135°, negated) in one
@@ -216,6 +224,11 @@ fn dominant_axis(vectors: &[DVec3]) -> Option<DVec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn track(bends: &[Option<Bend>], frame_time_s: f64) -> Vec<Option<DVec3>> {
+        let mut tracker = Tracker::new(frame_time_s);
+        bends.iter().map(|b| tracker.next(b.as_ref())).collect()
+    }
 
     fn bend(upper: DVec3, lower: DVec3, reference: DVec3) -> Option<Bend> {
         Bend::new(upper, lower, Some(reference), true)

@@ -14,7 +14,7 @@
 use crate::mocap::body::{Body, JOINTS, Joint, Kind};
 use crate::mocap::bvh::{Bvh, Warning};
 use crate::mocap::fk::{Kinematics, PositionMode, Transform, sample_frames};
-use crate::mocap::hinge::{self, Bend};
+use crate::mocap::hinge::{self, Bend, Tracker};
 use crate::mocap::mapping::{Landmark, Mapping, MappingError, SourcePoint, UserMapping, joint_list, map_skeleton};
 use crate::mocap::math::{Axis, frame_from_directions};
 use crate::mocap::pose::{Motion, Pose};
@@ -149,12 +149,17 @@ const LIMBS: [Limb; 4] = [
 /// is carried from frame to frame.
 const TRACKED: usize = LIMBS.len() + 2;
 
+/// Frames [`Retargeter::retarget`] solves at a time: enough to keep both
+/// cores busy, few enough that a piece's source frames (about 1.6 kB each)
+/// stay in cache.
+const PIECE_FRAMES: usize = 1024;
+
 /// The direction of limb `k`'s end (hand or foot): to its tip, else along
 /// the source end joint's own frame, calibrated.
 fn end_direction(f: &SourceFrame, cal: &Calibration, k: usize) -> Option<DVec3> {
     let end = LIMBS[k].end;
-    let (tip, _, _) = end_landmarks(end);
-    let from_tip = f.p(tip).zip(f.pj(end)).map(|(t, c)| t - c).filter(|d| d.length() > 0.0);
+    let from_tip =
+        Landmark::tip_of(end).and_then(|tip| f.p(tip)).zip(f.pj(end)).map(|(t, c)| t - c).filter(|d| d.length() > 0.0);
     from_tip.or_else(|| Some(f.sj(end)? * cal.end_bone[k]?))
 }
 
@@ -163,21 +168,20 @@ fn end_direction(f: &SourceFrame, cal: &Calibration, k: usize) -> Option<DVec3> 
 /// may flip half a turn between frames).
 fn end_twist(f: &SourceFrame, cal: &Calibration, k: usize) -> Option<(DVec3, bool)> {
     let end = LIMBS[k].end;
-    let (_, thumb, _) = end_landmarks(end);
+    let (thumb, _) = twist_landmarks(end);
     match thumb.and_then(|t| Some(f.p(t)? - f.pj(end)?)) {
         Some(t) => Some((t, false)),
         None => Some((f.sj(end)? * cal.end_twist[k]?, true)),
     }
 }
 
-/// For the limb ends: the tip that gives their direction and the landmark
-/// that gives their twist, and the rest-pose axis that twist lies along.
-fn end_landmarks(end: Joint) -> (Landmark, Option<Landmark>, DVec3) {
+/// For the limb ends: the landmark that gives their twist, and the
+/// rest-pose axis that twist lies along.
+fn twist_landmarks(end: Joint) -> (Option<Landmark>, DVec3) {
     match end {
-        Joint::LeftWrist => (Landmark::LeftHandTip, Some(Landmark::LeftThumb), DVec3::Z),
-        Joint::RightWrist => (Landmark::RightHandTip, Some(Landmark::RightThumb), DVec3::Z),
-        Joint::LeftAnkle => (Landmark::LeftToe, None, DVec3::X),
-        Joint::RightAnkle => (Landmark::RightToe, None, DVec3::X),
+        Joint::LeftWrist => (Some(Landmark::LeftThumb), DVec3::Z),
+        Joint::RightWrist => (Some(Landmark::RightThumb), DVec3::Z),
+        Joint::LeftAnkle | Joint::RightAnkle => (None, DVec3::X),
         _ => unreachable!("limb ends are wrists and ankles"),
     }
 }
@@ -288,40 +292,38 @@ impl Retargeter {
     }
 
     /// Retargets every frame: in parallel, but for the hinge axes, which
-    /// are carried from frame to frame ([`crate::mocap::hinge`]).
+    /// are carried from frame to frame ([`crate::mocap::hinge`]). A take
+    /// is solved in pieces of [`PIECE_FRAMES`], so the source frames each
+    /// piece's passes share stay in cache and their buffers are reused.
     pub fn retarget(&self, bvh: &Bvh) -> Motion {
         let channels = bvh.channel_count();
         let joints = bvh.skeleton.joints.len();
-        let frames = bvh.data.par_chunks(channels);
         let poses = if let Some(direct) = self.direct {
-            frames.map(|frame| self.direct_pose(frame, &direct)).collect()
+            bvh.data.par_chunks(channels).map(|frame| self.direct_pose(frame, &direct)).collect()
         } else {
-            let bends: Vec<[Option<Bend>; TRACKED]> = frames
-                .map_init(
-                    || vec![Transform::default(); joints],
-                    |scratch, frame| self.bends(&self.source_frame(frame, scratch), &self.cal),
-                )
-                .collect();
-            let axes: Vec<Vec<Option<DVec3>>> = (0..TRACKED)
-                .map(|k| {
-                    let limb: Vec<Option<Bend>> = bends.iter().map(|b| b[k]).collect();
-                    hinge::track(&limb, bvh.frame_time_s)
-                })
-                .collect();
-            bvh.data
-                .par_chunks(channels)
-                .enumerate()
-                .map_init(
-                    || vec![Transform::default(); joints],
-                    |scratch, (t, frame)| {
-                        let source = self.source_frame(frame, scratch);
-                        let world = self.solve(&source, &self.cal, std::array::from_fn(|k| axes[k][t]));
-                        let local = local_rotations(&world.rotations, &world.hinge_angles);
-                        let root = source.pj(Joint::Pelvis).unwrap_or(DVec3::ZERO) * self.scale;
-                        Pose::from_rotations(root, &local)
-                    },
-                )
-                .collect()
+            let mut trackers: [Tracker; TRACKED] = std::array::from_fn(|_| Tracker::new(bvh.frame_time_s));
+            let (mut sources, mut bends) = (Vec::new(), Vec::new());
+            let mut poses = Vec::with_capacity(bvh.frames);
+            for piece in bvh.data.chunks(channels * PIECE_FRAMES) {
+                piece
+                    .par_chunks(channels)
+                    .map_init(|| vec![Transform::default(); joints], |scratch, frame| self.source_frame(frame, scratch))
+                    .collect_into_vec(&mut sources);
+                sources.par_iter().map(|f| self.bends(f, &self.cal)).collect_into_vec(&mut bends);
+                // Each limb's axes run in frame order; the limbs are apart.
+                let axes: Vec<Vec<Option<DVec3>>> = trackers
+                    .par_iter_mut()
+                    .enumerate()
+                    .map(|(k, tracker)| bends.iter().map(|b| tracker.next(b[k].as_ref())).collect())
+                    .collect();
+                poses.par_extend(sources.par_iter().enumerate().map(|(t, source)| {
+                    let world = self.solve(source, &self.cal, std::array::from_fn(|k| axes[k][t]));
+                    let local = local_rotations(&world.rotations, &world.hinge_angles);
+                    let root = source.pj(Joint::Pelvis).unwrap_or(DVec3::ZERO) * self.scale;
+                    Pose::from_rotations(root, &local)
+                }));
+            }
+            poses
         };
         Motion { body: self.body.clone(), frame_time_s: bvh.frame_time_s, poses }
     }
@@ -439,10 +441,13 @@ impl Retargeter {
             let hinge = root * DQuat::from_axis_angle(rest_axis, angle);
             w[limb.hinge.index()] = hinge;
 
-            let (_, _, rest_twist) = end_landmarks(limb.end);
-            // A foot turns about the shin by little, and source foot frames
-            // flip: its twist is the shin's.
-            let twist = axes.get(LIMBS.len() + k).copied().flatten().unwrap_or(hinge * rest_twist);
+            let (_, rest_twist) = twist_landmarks(limb.end);
+            // A hand's twist is tracked (after the limbs' hinge axes, the
+            // arms first); a foot turns about the shin by little, and
+            // source foot frames flip, so its twist is the shin's.
+            let hand = matches!(limb.end, Joint::LeftWrist | Joint::RightWrist);
+            let tracked = if hand { axes[LIMBS.len() + k] } else { None };
+            let twist = tracked.unwrap_or(hinge * rest_twist);
             w[limb.end.index()] = orient(self.body.bone(limb.end), rest_twist, end_direction(f, cal, k), twist, hinge);
         }
         Solved { rotations: w, hinge_angles }

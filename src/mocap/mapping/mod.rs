@@ -122,6 +122,19 @@ impl SourcePoint {
 }
 
 impl Landmark {
+    /// The tip that gives a leaf joint's bone direction (the head's top,
+    /// a hand's tip, a foot's toe); `None` for the other joints.
+    pub fn tip_of(j: Joint) -> Option<Landmark> {
+        Some(match j {
+            Joint::Head => Landmark::HeadTop,
+            Joint::LeftWrist => Landmark::LeftHandTip,
+            Joint::RightWrist => Landmark::RightHandTip,
+            Joint::LeftAnkle => Landmark::LeftToe,
+            Joint::RightAnkle => Landmark::RightToe,
+            _ => return None,
+        })
+    }
+
     /// The landmark this one hangs below in the canonical body.
     fn above(self) -> Option<Landmark> {
         use Joint::*;
