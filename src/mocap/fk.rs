@@ -60,7 +60,7 @@ impl Kinematics {
             .skeleton
             .joints
             .iter()
-            .map(|joint| {
+            .map(|joint| -> (JointPlan, bool) {
                 let mut rotations = Vec::new();
                 let mut positions = [None; 3];
                 for (k, channel) in joint.channels.iter().enumerate() {
@@ -70,11 +70,11 @@ impl Kinematics {
                         Channel::Position(axis) => positions[axis.index()] = Some(index),
                     }
                 }
-                let mode = detect_mode(bvh, &samples, joint.offset, &positions);
-                JointPlan { parent: joint.parent, offset: joint.offset, rotations, positions, mode }
+                let (mode, settled) = detect_mode(bvh, &samples, joint.offset, &positions);
+                (JointPlan { parent: joint.parent, offset: joint.offset, rotations, positions, mode }, settled)
             })
             .collect();
-        Kinematics { joints }
+        Kinematics { joints: one_convention(joints) }
     }
 
     /// The position convention of joint `j`, when it has position channels.
@@ -149,27 +149,64 @@ pub fn spread_frames(frames: usize, count: usize) -> Vec<usize> {
     (0..n).map(|i| if n == 1 { 0 } else { i * (frames - 1) / (n - 1) }).collect()
 }
 
+/// A joint's channels are settled when they keep within this share of
+/// the offset's length of their median: the joint holds its place on its
+/// parent, as a bone does, so whether they sit at the offset or at zero
+/// shows the convention plainly.
+const SETTLED_SHARE: f64 = 0.1;
+
 /// Absolute when the channels' typical values sit nearer the OFFSET than
 /// zero: deltas hover around zero, absolute positions around the offset.
-fn detect_mode(bvh: &Bvh, samples: &[usize], offset: DVec3, positions: &[Option<usize>; 3]) -> PositionMode {
+/// Also says whether the joint is settled (see [`SETTLED_SHARE`]); a joint
+/// that travels (the hips carrying the body across the room) has no
+/// typical value to go by.
+fn detect_mode(bvh: &Bvh, samples: &[usize], offset: DVec3, positions: &[Option<usize>; 3]) -> (PositionMode, bool) {
     if offset.length() < 1e-9 || positions.iter().all(Option::is_none) || samples.is_empty() {
-        return PositionMode::Delta;
+        return (PositionMode::Delta, false);
     }
     let mut typical = DVec3::ZERO;
     let mut offset_on_channels = DVec3::ZERO;
+    let mut spread = DVec3::ZERO;
     for (axis, channel) in positions.iter().enumerate() {
         if let Some(index) = channel {
             let mut values: Vec<f64> = samples.iter().map(|&f| bvh.frame(f)[*index]).collect();
             values.sort_by(f64::total_cmp);
             typical[axis] = values[values.len() / 2];
+            spread[axis] = values.iter().map(|v| (v - typical[axis]).abs()).fold(0.0, f64::max);
             offset_on_channels[axis] = offset[axis];
         }
     }
-    if (typical - offset_on_channels).length() < typical.length() {
+    let mode = if (typical - offset_on_channels).length() < typical.length() {
         PositionMode::Absolute
     } else {
         PositionMode::Delta
-    }
+    };
+    (mode, spread.length() <= SETTLED_SHARE * offset.length())
+}
+
+/// One file, one convention: exporters do not mix them. Every joint below
+/// the root takes the convention the settled joints show, when they agree
+/// by a clear majority: the joint that disagrees is the one carrying the
+/// body about the room (its OFFSET is where the take's rest pose stood,
+/// its channels where the body is now), whose own reading cannot be
+/// trusted. A file with no clear majority keeps each joint's own reading.
+fn one_convention(joints: Vec<(JointPlan, bool)>) -> Vec<JointPlan> {
+    let settled = |mode| joints.iter().filter(|(p, s)| *s && p.parent.is_some() && p.mode == mode).count();
+    let (absolute, delta) = (settled(PositionMode::Absolute), settled(PositionMode::Delta));
+    let file_mode = match (absolute, delta) {
+        (a, d) if a > 2 * d => Some(PositionMode::Absolute),
+        (a, d) if d > 2 * a => Some(PositionMode::Delta),
+        _ => None,
+    };
+    joints
+        .into_iter()
+        .map(|(mut plan, _)| {
+            if let (Some(mode), Some(_)) = (file_mode, plan.parent) {
+                plan.mode = mode;
+            }
+            plan
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -205,6 +242,34 @@ mod tests {
             two_bone("CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation", "0 0 0 0 0.5 0 0 0 0");
         assert_eq!(Kinematics::new(&bvh).position_mode(1), Some(PositionMode::Delta));
         assert!((joint_b_height(&bvh) - 10.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_travelling_joint_takes_the_convention_its_settled_bones_show() {
+        // As Bandai's exports: the hips carry the body across the room on
+        // absolute channels, far from both their OFFSET and zero, while the
+        // spine's channels repeat its OFFSET.
+        // Whether the take walks through the room or stands in one spot
+        // away from where its rest pose stood, the hips read the same way.
+        let six = "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation";
+        let bones = "0 15 0 0 0 0 0 12 0 0 0 0 0 10 0 0 0 0";
+        for depths in [[-500.0, -250.0, 0.0, 250.0, 500.0], [-5.0, -4.0, -5.0, -6.0, -5.0]] {
+            let mut frames = String::new();
+            for z in depths {
+                frames += &format!("0 0 0 0 0 0 1 90 {z} 0 0 0 {bones}\n");
+            }
+            let text = format!(
+                "HIERARCHY\nROOT root\n{{\nOFFSET 0 0 0\n{six}\nJOINT hips\n{{\nOFFSET 4 91 -427\n{six}\nJOINT spine\n{{\nOFFSET 0 15 0\n{six}\nJOINT chest\n{{\nOFFSET 0 12 0\n{six}\nJOINT neck\n{{\nOFFSET 0 10 0\n{six}\nEnd Site\n{{\nOFFSET 0 5 0\n}}\n}}\n}}\n}}\n}}\n}}\nMOTION\nFrames: 5\nFrame Time: 0.1\n{frames}"
+            );
+            let bvh = read_bvh_bytes(text.as_bytes(), "test.bvh").unwrap();
+            let kin = Kinematics::new(&bvh);
+            assert_eq!(kin.position_mode(2), Some(PositionMode::Absolute));
+            assert_eq!(kin.position_mode(1), Some(PositionMode::Absolute));
+            let mut out = vec![Transform::default(); 5];
+            kin.world(bvh.frame(2), &[true; 5], &mut out);
+            let expected = DVec3::new(1.0, 90.0, depths[2]);
+            assert!((out[1].position - expected).length() < 1e-12, "{:?}", out[1].position);
+        }
     }
 
     #[test]
