@@ -107,9 +107,32 @@ pub fn rounded_option<S: serde::Serializer>(v: &Option<f64>, s: S) -> Result<S::
     }
 }
 
+/// Rounds every fractional number in `value` (and below it) to six
+/// decimals, as the JSON files the program writes keep them.
+pub fn round6_json(value: &mut serde_json::Value) {
+    match value {
+        serde_json::Value::Number(n) if n.is_f64() => {
+            if let Some(r) = n.as_f64().map(round6).and_then(serde_json::Number::from_f64) {
+                *n = r;
+            }
+        }
+        serde_json::Value::Array(items) => items.iter_mut().for_each(round6_json),
+        serde_json::Value::Object(fields) => fields.values_mut().for_each(round6_json),
+        _ => {}
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn json_numbers_are_rounded_to_six_decimals_wherever_they_are() {
+        let mut v =
+            serde_json::json!({"a": 0.1234567891, "b": [1, 2.0000004, {"c": -3.14159265}], "d": "x", "e": null});
+        round6_json(&mut v);
+        assert_eq!(v, serde_json::json!({"a": 0.123457, "b": [1, 2.0, {"c": -3.141593}], "d": "x", "e": null}));
+    }
 
     #[test]
     fn failed_write_leaves_neither_target_nor_temporary_file() {

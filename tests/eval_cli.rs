@@ -33,16 +33,18 @@ fn a_quick_evaluation_reports_every_trial_with_the_numbers_of_its_metrics_json()
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     let real = real_mocap_dir().map_or("absent".to_string(), |d| d.display().to_string());
+    let mocap = real_mocap_dir().map_or("absent".to_string(), |d| d.parent().unwrap().display().to_string());
     // One work folder for both runs: the vocabulary built there records its
     // sources' paths.
-    let eval = |out: &str| ok(run(dir, &["eval", "--quick", "-o", out, "--work", "work", "--real", &real]));
+    let eval =
+        |out: &str| ok(run(dir, &["eval", "--quick", "-o", out, "--work", "work", "--real", &real, "--mocap", &mocap]));
     eval("a");
     let report = dir.join("a");
     let metrics = json(&report.join("metrics.json"));
     assert_eq!(metrics["schema"], "imitate-eval/1");
     let mut trials = vec!["particles", "recognition", "speed", "viewpoint", "baseline"];
     if real != "absent" {
-        trials.push("real");
+        trials.extend(["real", "mocap_styles"]);
     }
     let keys: Vec<&str> = metrics["trials"].as_object().unwrap().keys().map(String::as_str).collect();
     let mut expected = trials.clone();
@@ -77,6 +79,32 @@ fn a_quick_evaluation_reports_every_trial_with_the_numbers_of_its_metrics_json()
             if !s["recognition_settled"].is_null() {
                 assert!(html.contains(&cell(&s["recognition_settled"], 100.0)), "{trial} {}: recognition", s["x"]);
             }
+        }
+    }
+    // The real motion capture's tables: their cells on the page, their CSV
+    // a row per metrics.json row.
+    if mocap != "absent" {
+        let tables = metrics["tables"].as_object().unwrap();
+        let keys: Vec<&str> = tables.keys().map(String::as_str).collect();
+        assert_eq!(keys, ["mocap_corpora", "mocap_held_out", "mocap_projection", "mocap_vocabularies"]);
+        for (key, rows) in tables {
+            let csv = fs::read_to_string(report.join(format!("{key}.csv"))).unwrap();
+            assert_eq!(csv.lines().count(), rows.as_array().unwrap().len() + 1, "{key}.csv: a row per row");
+        }
+        let corpora = tables["mocap_corpora"].as_array().unwrap();
+        let all = corpora.last().unwrap();
+        assert_eq!(all["corpus"], "all");
+        assert_eq!(all["mapped"], all["takes"], "every real take maps with no mapping file");
+        assert!(html.contains(&format!("{} of {}", all["mapped"], all["takes"])));
+        for row in tables["mocap_vocabularies"].as_array().unwrap() {
+            let purity = row["purity"].as_f64().unwrap();
+            assert!(html.contains(&format!("{purity:.3}")), "{}: purity", row["corpus"]);
+        }
+        let held_out = tables["mocap_held_out"].as_array().unwrap();
+        assert!(held_out.iter().any(|r| r["corpus"] == "bandai dataset 2" && r["group"] == "normal"));
+        for row in held_out {
+            let cosine = row["latent_cosine"].as_f64().unwrap();
+            assert!(html.contains(&format!("{cosine:.3}")), "{} {}: field cosine", row["corpus"], row["group"]);
         }
     }
     // The headline numbers point into metrics.json.

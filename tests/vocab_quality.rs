@@ -4,23 +4,14 @@
 
 mod common;
 
-use imitate::vocab::cluster::ClusterParams;
 use imitate::vocab::corpus::{Corpus, load, read_labels};
-use imitate::vocab::embed::EmbedParams;
 use imitate::vocab::evaluate::{
     activities_without_primitive, benchmark_stream, check_held_out, cluster_scores, held_out_stream,
 };
 use imitate::vocab::pipeline::{Build, BuildParams, build};
-use imitate::vocab::primitive::FitParams;
-use imitate::vocab::segment::SegmentParams;
 
 fn defaults() -> BuildParams {
-    BuildParams {
-        segment: SegmentParams::new().check().unwrap(),
-        embed: EmbedParams::new().check().unwrap(),
-        cluster: ClusterParams::new().check().unwrap(),
-        fit: FitParams::new().check().unwrap(),
-    }
+    BuildParams::standard()
 }
 
 fn learn(corpus: &Corpus) -> Build {

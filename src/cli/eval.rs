@@ -1,5 +1,7 @@
 //! `imitate eval`: the paper's trials, run end to end, as a report.
 
+mod mocap;
+
 use super::report::silhouettes;
 use super::{Global, Outcome, UsageError, arg, invoke, refuse_nonempty};
 use anyhow::Context;
@@ -43,6 +45,11 @@ pub struct Args {
     /// Real captures for the real-motion trial (skipped when absent).
     #[arg(long, value_name = "DIR", default_value = "../shared/mocap/real")]
     pub real: PathBuf,
+    /// Real motion capture corpora for the real-capture tables and the
+    /// held-out-style trial: every subfolder holding BVH takes and a
+    /// labels.csv (skipped when absent).
+    #[arg(long, value_name = "DIR", default_value = "../shared/mocap")]
+    pub mocap: PathBuf,
     /// Keep the trials' videos and runs here [default: a temporary folder,
     /// removed afterwards].
     #[arg(long, value_name = "DIR")]
@@ -110,6 +117,23 @@ struct Video {
 }
 
 impl Work {
+    /// The same folder, seeds and progress, tracking with `vocab`; its runs
+    /// join this one's with [`Work::absorb`].
+    fn with_vocab(&self, vocab: PathBuf) -> Work {
+        Work {
+            vocab,
+            seeds: self.seeds.clone(),
+            bar: self.bar.clone(),
+            dir: self.dir.clone(),
+            done: RefCell::default(),
+        }
+    }
+
+    /// Counts `other`'s runs as this one's.
+    fn absorb(&self, other: Work) {
+        self.done.borrow_mut().extend(other.done.take());
+    }
+
     fn path(&self, name: &str) -> PathBuf {
         self.dir.join(name)
     }
@@ -338,6 +362,8 @@ fn evaluate(args: &Args, global: Global, dir: &Path) -> anyhow::Result<Outcome> 
     if let Some(real) = real_trial(&work, &args.real)? {
         trials.push(real);
     }
+    let (tables, styles) = mocap::section(&work, &args.mocap)?;
+    trials.extend(styles);
     work.bar.finish_and_clear();
 
     let first_run = Run::read(&first)?;
@@ -359,7 +385,7 @@ fn evaluate(args: &Args, global: Global, dir: &Path) -> anyhow::Result<Outcome> 
                 .collect::<Vec<_>>(),
         }),
     };
-    let files = eval_report(&provenance, &trials, &first_metrics.recognition.confusion, &machine());
+    let files = eval_report(&provenance, &trials, &tables, &first_metrics.recognition.confusion, &machine());
     let shown = arg(&args.output);
     let io = |e: std::io::Error| anyhow::anyhow!("{shown}: cannot write: {e}");
     let write = |d: &Path| files.iter().try_for_each(|(name, bytes)| std::fs::write(d.join(name), bytes)).map_err(io);
@@ -586,13 +612,7 @@ fn real_trial(work: &Work, real: &Path) -> anyhow::Result<Option<Trial>> {
     build.extend(takes.iter().map(|p| arg(p)));
     build.extend(["--labels".into(), arg(&real_labels), "-o".into(), arg(&vocab)]);
     invoke(&build)?;
-    let real_work = Work {
-        vocab,
-        seeds: work.seeds.clone(),
-        bar: work.bar.clone(),
-        dir: work.dir.clone(),
-        done: RefCell::default(),
-    };
+    let real_work = work.with_vocab(vocab);
     let mut settings = Vec::new();
     for take in tracked {
         let name = take.trim_end_matches(".bvh");
@@ -611,7 +631,7 @@ fn real_trial(work: &Work, real: &Path) -> anyhow::Result<Option<Trial>> {
         let label = Label { series: "eq. 10", x: name.into(), params: serde_json::json!({"take": take}) };
         settings.push(real_work.setting(&video, label, &["--feedback"])?);
     }
-    work.done.borrow_mut().extend(real_work.done.take());
+    work.absorb(real_work);
     Ok(Some(Trial {
         key: "real".into(),
         title: "Real motion".into(),

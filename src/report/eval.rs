@@ -187,6 +187,27 @@ impl Trial {
     }
 }
 
+/// Figures that are not tracking runs (the real motion capture: its
+/// corpora, vocabularies, held-out groups): a table on the page, the same
+/// cells as CSV, and the figures unrounded in `metrics.json`.
+pub struct Table {
+    /// Its key under `tables` in `metrics.json` and the stem of its CSV.
+    pub key: String,
+    pub title: String,
+    pub about: String,
+    pub columns: Vec<String>,
+    pub rows: Vec<Vec<String>>,
+    /// One object per row, with the figures the cells show.
+    pub metrics: serde_json::Value,
+}
+
+impl Table {
+    fn csv(&self) -> String {
+        let line = |cells: &[String]| cells.iter().map(|c| csv_field(c)).collect::<Vec<_>>().join(",") + "\n";
+        std::iter::once(line(&self.columns)).chain(self.rows.iter().map(|r| line(r))).collect()
+    }
+}
+
 /// The header of every trial table (page and CSV).
 const COLUMNS: [&str; 7] =
     ["series", "setting", "seeds", "upper body (mm)", "hands (mm)", "recognition, settled (%)", "likelihoods/frame"];
@@ -275,6 +296,7 @@ fn headline(trials: &[Trial]) -> Vec<(String, String, String)> {
 pub fn eval_report(
     provenance: &Provenance,
     trials: &[Trial],
+    tables: &[Table],
     confusion: &BTreeMap<String, BTreeMap<String, usize>>,
     machine: &str,
 ) -> Vec<File> {
@@ -316,6 +338,19 @@ pub fn eval_report(
         }
     }
     metrics.insert("trials".into(), trial_metrics.into());
+    let mut table_metrics = serde_json::Map::new();
+    for table in tables {
+        page.heading(&table.title);
+        page.paragraph(&table.about);
+        page.table(&table.columns, &table.rows);
+        files.push((format!("{}.csv", table.key), table.csv().into_bytes()));
+        let mut numbers = table.metrics.clone();
+        crate::fsutil::round6_json(&mut numbers);
+        table_metrics.insert(table.key.clone(), numbers);
+    }
+    if !tables.is_empty() {
+        metrics.insert("tables".into(), table_metrics.into());
+    }
     metrics.insert("confusion".into(), serde_json::to_value(confusion).expect("plain data"));
     if !confusion.is_empty() {
         page.heading("Confusion (trial one, eq. 10, first seed)");

@@ -4,7 +4,10 @@
 
 use crate::fsutil::{rounded, rounded_option};
 use crate::mocap::body::{JOINTS, Joint};
+use crate::mocap::pose::{Motion, Pose};
+use crate::vocab::primitive::Primitive;
 use glam::DVec3;
+use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -198,6 +201,42 @@ pub fn root_relative_m(estimate: &[DVec3; JOINTS], truth: &[DVec3; JOINTS], j: u
     (estimate[j] - estimate[pelvis]).distance(truth[j] - truth[pelvis])
 }
 
+/// How far `motion` lies from a vocabulary's primitives: the upper-body
+/// error (root-relative, mm, as [`score`] measures it) of each frame's pose
+/// projected into a primitive's latent space (eq. 3, there and back),
+/// through whichever primitive's projection comes nearest that frame,
+/// averaged over the frames. Large where the motion's poses are ones no
+/// primitive learned; a tracker held to the primitives' spaces rarely does
+/// much better. `None` without primitives or frames.
+pub fn latent_projection_mm(primitives: &[Primitive], motion: &Motion) -> Option<f64> {
+    if primitives.is_empty() || motion.poses.is_empty() {
+        return None;
+    }
+    let positions = |pose: &Pose| -> [DVec3; JOINTS] {
+        let frame = motion.body.forward(pose);
+        std::array::from_fn(|j| frame.position(Joint::ALL[j]))
+    };
+    // Collected before summing: a parallel sum's order, and so its last
+    // bits, would vary from run to run.
+    let per_frame: Vec<f64> = motion
+        .poses
+        .par_iter()
+        .map(|pose| {
+            let truth = positions(pose);
+            primitives
+                .iter()
+                .map(|p| {
+                    let held = Pose { x: p.reconstruct(&p.project(&pose.x)), ..*pose };
+                    let near = positions(&held);
+                    UPPER_BODY.iter().map(|j| root_relative_m(&near, &truth, j.index())).sum::<f64>()
+                        / UPPER_BODY.len() as f64
+                })
+                .fold(f64::INFINITY, f64::min)
+        })
+        .collect();
+    Some(1000.0 * per_frame.iter().sum::<f64>() / per_frame.len() as f64)
+}
+
 /// Scores `estimate` (a run's `frames.csv`) against `truth` (the render's
 /// `truth.csv`), row by row; the rows must be the same frames. A frame
 /// counts as a switch of activity, and starts a settling window of
@@ -386,6 +425,22 @@ fn recognize(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn motion_a_vocabulary_learned_projects_near_it_and_motion_it_never_saw_far_from_it() {
+        use crate::mocap::synth::{Activity, SynthOptions, activity_take};
+        use crate::vocab::evaluate::benchmark_stream;
+        use crate::vocab::pipeline::{BuildParams, build};
+        // Circles, waving both ways and punching, learned.
+        let built = build(&benchmark_stream(1), &BuildParams::standard(), |_| {}).unwrap();
+        let primitives = &built.fitted.primitives;
+        let options = SynthOptions { repetitions: 4, seed: 77, ..Default::default() };
+        let seen = latent_projection_mm(primitives, &activity_take(Activity::WaveH, &options).motion).unwrap();
+        let unseen = latent_projection_mm(primitives, &activity_take(Activity::Twist, &options).motion).unwrap();
+        assert!(seen < 15.0, "waving, learned: {seen:.1} mm");
+        assert!(unseen > 3.0 * seen, "twisting, never learned: {unseen:.1} mm against {seen:.1} mm");
+        assert_eq!(latent_projection_mm(&[], &activity_take(Activity::WaveH, &options).motion), None);
+    }
 
     #[test]
     fn limb_angles_are_exact_at_0_and_180_degrees_and_ignore_length() {

@@ -113,36 +113,72 @@ pub fn expand_inputs(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, CorpusError> {
 /// Reads a labels CSV: a header naming `file` or `frame` and `activity`
 /// (other columns are ignored), then one row per file or per frame.
 pub fn read_labels(path: &Path) -> Result<Labels, CorpusError> {
-    let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| CorpusError::Io { path: name.clone(), source })?;
+    let (text, name) = read_text(path)?;
     parse_labels(&text, &name)
 }
 
+fn read_text(path: &Path) -> Result<(String, String), CorpusError> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| CorpusError::Io { path: name.clone(), source })?;
+    Ok((text, name))
+}
+
+/// A labels CSV's header and rows (blank lines skipped), for errors that
+/// name the file and line.
+struct Csv<'a> {
+    name: &'a str,
+    header: &'a str,
+    columns: Vec<&'a str>,
+    /// Line number (from 1) and text of each row after the header.
+    rows: Vec<(usize, &'a str)>,
+}
+
+impl<'a> Csv<'a> {
+    fn parse(text: &'a str, name: &'a str) -> Result<Csv<'a>, CorpusError> {
+        let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()).map(|(i, l)| (i + 1, l));
+        let Some((_, header)) = lines.next() else {
+            return Err(CorpusError::BadLabels { path: format!("{name}:1"), problem: "the file is empty".into() });
+        };
+        let columns = header.split(',').map(str::trim).collect();
+        Ok(Csv { name, header, columns, rows: lines.collect() })
+    }
+
+    fn bad(&self, line: usize, problem: String) -> CorpusError {
+        CorpusError::BadLabels { path: format!("{}:{line}", self.name), problem }
+    }
+
+    fn find(&self, column: &str) -> Option<usize> {
+        self.columns.iter().position(|h| *h == column)
+    }
+
+    fn require(&self, column: &str) -> Result<usize, CorpusError> {
+        self.find(column).ok_or_else(|| self.bad(1, format!("no `{column}` column in the header `{}`", self.header)))
+    }
+}
+
 fn parse_labels(text: &str, name: &str) -> Result<Labels, CorpusError> {
-    let bad = |line: usize, problem: String| CorpusError::BadLabels { path: format!("{name}:{line}"), problem };
-    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
-    let (_, header) = lines.next().ok_or_else(|| bad(1, "the file is empty".into()))?;
-    let columns: Vec<&str> = header.split(',').map(str::trim).collect();
-    let find = |c: &str| columns.iter().position(|h| *h == c);
-    let activity = find("activity").ok_or_else(|| bad(1, format!("no `activity` column in the header `{header}`")))?;
-    let (file, frame) = (find("file"), find("frame"));
+    let csv = Csv::parse(text, name)?;
+    let bad = |line: usize, problem: String| csv.bad(line, problem);
+    let header = csv.header;
+    let activity = csv.require("activity")?;
+    let (file, frame) = (csv.find("file"), csv.find("frame"));
     if file.is_none() && frame.is_none() {
         return Err(bad(1, format!("the header `{header}` names neither `file` nor `frame`")));
     }
     let mut per_file = BTreeMap::new();
     let mut per_frame: BTreeMap<String, Vec<String>> = BTreeMap::new();
-    for (i, line) in lines {
+    for &(i, line) in &csv.rows {
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        let field = |c: usize| fields.get(c).copied().ok_or_else(|| bad(i + 1, format!("too few fields in `{line}`")));
+        let field = |c: usize| fields.get(c).copied().ok_or_else(|| bad(i, format!("too few fields in `{line}`")));
         let label = field(activity)?.to_string();
         let name = file.map(|c| field(c).map(file_name)).transpose()?.unwrap_or_default();
         match frame {
             Some(c) => {
                 let text = field(c)?;
-                let n: usize = text.parse().map_err(|_| bad(i + 1, format!("frame `{text}` is not a whole number")))?;
+                let n: usize = text.parse().map_err(|_| bad(i, format!("frame `{text}` is not a whole number")))?;
                 let frames = per_frame.entry(name).or_default();
                 if n != frames.len() {
-                    return Err(bad(i + 1, format!("frame {n} where frame {} was expected", frames.len())));
+                    return Err(bad(i, format!("frame {n} where frame {} was expected", frames.len())));
                 }
                 frames.push(label);
             }
@@ -158,8 +194,32 @@ fn parse_labels(text: &str, name: &str) -> Result<Labels, CorpusError> {
     })
 }
 
+/// Another column of a per-file labels CSV (say `style`, or `performer`),
+/// by file name: the groups a leave-one-group-out evaluation holds out.
+/// Files with an empty value are left out.
+pub fn read_label_column(path: &Path, column: &str) -> Result<BTreeMap<String, String>, CorpusError> {
+    let (text, name) = read_text(path)?;
+    label_column(&text, &name, column)
+}
+
+fn label_column(text: &str, name: &str, column: &str) -> Result<BTreeMap<String, String>, CorpusError> {
+    let csv = Csv::parse(text, name)?;
+    let (file, wanted) = (csv.require("file")?, csv.require(column)?);
+    let mut out = BTreeMap::new();
+    for &(i, line) in &csv.rows {
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        let (Some(f), Some(v)) = (fields.get(file), fields.get(wanted)) else {
+            return Err(csv.bad(i, format!("too few fields in `{line}`")));
+        };
+        if !v.is_empty() {
+            out.insert(file_name(f), v.to_string());
+        }
+    }
+    Ok(out)
+}
+
 /// The last component of a path, which labels files use to name takes.
-fn file_name(path: &str) -> String {
+pub fn file_name(path: &str) -> String {
     Path::new(path).file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| path.to_string())
 }
 
@@ -265,6 +325,20 @@ mod tests {
         let Labels::PerFile(map) = parse_labels(text, "labels.csv").unwrap() else { panic!("per file") };
         assert_eq!(map.get("boxing.bvh").map(String::as_str), Some("punch"));
         assert_eq!(map.get("dab.bvh").map(String::as_str), Some("gesture"));
+    }
+
+    #[test]
+    fn another_column_is_read_by_file_name_and_empty_values_are_left_out() {
+        let text = "file,activity,style\nsub/a.bvh,walk,elderly\nb.bvh,run,\n\nc.bvh,run,normal\n";
+        let styles = label_column(text, "l.csv", "style").unwrap();
+        assert_eq!(
+            styles.into_iter().collect::<Vec<_>>(),
+            [("a.bvh".into(), "elderly".into()), ("c.bvh".into(), "normal".into())]
+        );
+        let err = label_column(text, "l.csv", "performer").unwrap_err().to_string();
+        assert_eq!(err, "l.csv:1: no `performer` column in the header `file,activity,style`");
+        let err = label_column("file,style\na.bvh\n", "l.csv", "style").unwrap_err().to_string();
+        assert_eq!(err, "l.csv:2: too few fields in `a.bvh`");
     }
 
     #[test]

@@ -261,13 +261,7 @@ pub fn check_held_out(
     // The primitive fitted to each training segment's cluster, if any.
     let primitive_of: Vec<Option<usize>> =
         (0..build.segments.len()).map(|i| fitted.members.iter().position(|m| m.contains(&i))).collect();
-    // `circles`, `circles-2`, … all belong to `circles`.
-    let activities: BTreeSet<&str> = fitted
-        .primitives
-        .iter()
-        .map(|p| p.name())
-        .map(|name| name.rsplit_once('-').filter(|(_, n)| n.parse::<u32>().is_ok()).map_or(name, |(a, _)| a))
-        .collect();
+    let activities: BTreeSet<&str> = fitted.primitives.iter().map(|p| activity_of(p.name())).collect();
     let repetitions: Vec<RepetitionCheck> = rows
         .par_iter()
         .zip(&fresh)
@@ -293,6 +287,12 @@ pub fn check_held_out(
     Ok(HeldOutReport { repetitions, unmatched })
 }
 
+/// The activity a primitive stands for: its name without a repeat's
+/// number (`circles`, `circles-2`, … all stand for `circles`).
+pub fn activity_of(primitive: &str) -> &str {
+    primitive.rsplit_once('-').filter(|(_, n)| n.parse::<u32>().is_ok()).map_or(primitive, |(a, _)| a)
+}
+
 fn squared_distance(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum()
 }
@@ -315,6 +315,14 @@ fn joint_fields(build: &Build, corpus: &Corpus, fit: &ValidFitParams) -> Result<
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_repeat_number_is_not_part_of_the_activity() {
+        assert_eq!(activity_of("circles-2"), "circles");
+        assert_eq!(activity_of("wave-left-hand"), "wave-left-hand");
+        assert_eq!(activity_of("wave-left-hand-12"), "wave-left-hand");
+        assert_eq!(activity_of("p3"), "p3");
+    }
 
     #[test]
     fn unwrapping_takes_each_step_the_short_way_round() {

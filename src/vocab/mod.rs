@@ -9,6 +9,7 @@ pub mod corpus;
 pub mod eigen;
 pub mod embed;
 pub mod evaluate;
+pub mod holdout;
 pub mod knn;
 pub mod metrics;
 pub mod pca;

@@ -268,6 +268,18 @@ pub struct BuildParams {
     pub fit: ValidFitParams,
 }
 
+impl BuildParams {
+    /// Every stage's defaults, as `vocab build` takes them.
+    pub fn standard() -> BuildParams {
+        BuildParams {
+            segment: crate::vocab::segment::SegmentParams::new().check().expect("the defaults are valid"),
+            embed: crate::vocab::embed::EmbedParams::new().check().expect("the defaults are valid"),
+            cluster: crate::vocab::cluster::ClusterParams::new().check().expect("the defaults are valid"),
+            fit: crate::vocab::primitive::FitParams::new().check().expect("the defaults are valid"),
+        }
+    }
+}
+
 /// Runs all stages; `stage` is told as each one starts (for progress).
 pub fn build(corpus: &Corpus, params: &BuildParams, mut stage: impl FnMut(&str)) -> Result<Build, BuildError> {
     stage("segment");
