@@ -102,7 +102,10 @@ if [ -d "$real" ]; then
   for f in "$real"/*.bvh; do
     case "$(basename "$f")" in wave_hello.bvh | boxing.bvh) ;; *) ln -sf "$f" realtrain/ ;; esac
   done
-  sed -E 's/,(wave_left|wave_right|wave_both),/,wave,/' "$real/labels.csv" > realtrain/labels.csv
+  # (The tracked takes' lines go too: a labels file may not name takes
+  # that are not there.)
+  sed -E -e 's/,(wave_left|wave_right|wave_both),/,wave,/' -e '/^(wave_hello|boxing)\.bvh,/d' \
+    "$real/labels.csv" > realtrain/labels.csv
   "$imitate" -q vocab build realtrain --labels realtrain/labels.csv -o real.vocab
   header "Real motion: tracked with a vocabulary of the other real captures (6 particles, eq. 10)"
   # The front camera, turned round for a performer who faces away from it

@@ -129,9 +129,9 @@ mod tests {
     #[test]
     fn json_numbers_are_rounded_to_six_decimals_wherever_they_are() {
         let mut v =
-            serde_json::json!({"a": 0.1234567891, "b": [1, 2.0000004, {"c": -3.14159265}], "d": "x", "e": null});
+            serde_json::json!({"a": 0.1234567891, "b": [1, 2.0000004, {"c": -4.56789012}], "d": "x", "e": null});
         round6_json(&mut v);
-        assert_eq!(v, serde_json::json!({"a": 0.123457, "b": [1, 2.0, {"c": -3.141593}], "d": "x", "e": null}));
+        assert_eq!(v, serde_json::json!({"a": 0.123457, "b": [1, 2.0, {"c": -4.56789}], "d": "x", "e": null}));
     }
 
     #[test]

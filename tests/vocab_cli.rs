@@ -111,8 +111,19 @@ fn the_stages_run_one_by_one_write_the_vocabulary_vocab_build_writes() {
     assert!(said.contains("brief.bvh: warning: skipped: no segment of at least 0.2 s in its 0.13 s"), "{said}");
     // Parquet and CSV in turn: the format of a stage file changes nothing.
     ok(&[&"segment", &mocap(), &t("brief.bvh"), &"--labels", &labels(), &"-o", &t("segments.parquet")]);
-    ok(&[&"embed", &t("segments.parquet"), &"-o", &t("embedding.csv")]);
+    ok(&[&"embed", &t("segments.parquet"), &"-o", &t("embedding.csv"), &"--vectors", &t("vectors.csv")]);
     ok(&[&"cluster", &t("embedding.csv"), &"-o", &t("clusters.parquet")]);
+    // The vectors the segments were compared as: one row a segment, with
+    // its label, 20 poses of every joint-space number.
+    let vectors = fs::read_to_string(t("vectors.csv")).unwrap();
+    let rows: Vec<&str> = vectors.lines().collect();
+    let header: Vec<&str> = rows[0].split(',').collect();
+    assert_eq!(header[..3], ["segment", "label", "v0"]);
+    assert_eq!(header.len(), 2 + 20 * imitate::mocap::body::DOF);
+    let embedded = fs::read_to_string(t("embedding.csv")).unwrap();
+    assert_eq!(rows.len() - 1, embedded.lines().filter(|l| !l.starts_with('#')).count() - 1);
+    assert!(rows[1..].iter().all(|r| r.split(',').count() == header.len()));
+    assert!(rows.iter().any(|r| r.split(',').nth(1) == Some("circles")));
     ok(&[&"fit", &t("clusters.parquet"), &"-o", &t("primitives")]);
     ok(&[&"export", &t("primitives"), &"-o", &t("staged.vocab")]);
     let (built, staged) = (fs::read(t("built.vocab")).unwrap(), fs::read(t("staged.vocab")).unwrap());

@@ -3,11 +3,14 @@
 use super::learn::EmbedArgs;
 use super::{Global, Outcome, count, note, progress};
 use anyhow::Context;
+use imitate::fsutil::write_atomic;
+use imitate::vision::truth::quoted;
 use imitate::vocab::corpus::Corpus;
 use imitate::vocab::embed::ValidEmbedParams;
-use imitate::vocab::pipeline::embed_segments;
+use imitate::vocab::pipeline::{SegmentRow, embed_segments, segment_vectors};
 use imitate::vocab::stages::{Embedded, Segments};
-use std::path::PathBuf;
+use std::io::Write;
+use std::path::{Path, PathBuf};
 
 /// Embed segments by spatio-temporal Isomap: a neighbourhood graph over
 /// the segments' paths with temporally adjacent and common temporal
@@ -24,6 +27,11 @@ pub struct Args {
     pub output: PathBuf,
     #[command(flatten)]
     pub embed: EmbedArgs,
+    /// Also write the vectors the segments are compared as (each resampled
+    /// along its path and flattened) to this CSV, with each segment's
+    /// label: the features to try another learner on.
+    #[arg(long, value_name = "FILE.csv")]
+    pub vectors: Option<PathBuf>,
 }
 
 /// Embeds segments and says how.
@@ -61,7 +69,36 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let corpus = segments.load_motion(&args.segments)?;
     bar.finish_and_clear();
     let embedded = embed(&corpus, segments, &params, global).with_context(|| args.segments.display().to_string())?;
-    embedded.write(&args.output)?;
+    // Both files or neither.
+    if let Some(path) = &args.vectors {
+        write_vectors(path, &corpus, &embedded.segments.rows, params.params().resample)?;
+    }
+    if let Err(e) = embedded.write(&args.output) {
+        if let Some(path) = &args.vectors {
+            let _ = std::fs::remove_file(path);
+        }
+        return Err(e.into());
+    }
     note(global, &format!("wrote {}", args.output.display()));
     Ok(Outcome::Success)
+}
+
+/// The segment vectors as CSV: `segment`, `label` (empty when unlabelled),
+/// then `v0`, `v1`, … (`resample` poses of every joint-space number, pose
+/// by pose, radians).
+fn write_vectors(path: &Path, corpus: &Corpus, rows: &[SegmentRow], resample: usize) -> anyhow::Result<()> {
+    let (vectors, _) = segment_vectors(corpus, rows, resample);
+    let width = vectors.first().map_or(0, Vec::len);
+    write_atomic(path, |w| {
+        write!(w, "segment,label")?;
+        (0..width).try_for_each(|i| write!(w, ",v{i}"))?;
+        writeln!(w)?;
+        for (i, (row, vector)) in rows.iter().zip(&vectors).enumerate() {
+            write!(w, "{i},{}", quoted(row.label.as_deref().unwrap_or("")))?;
+            vector.iter().try_for_each(|v| write!(w, ",{v}"))?;
+            writeln!(w)?;
+        }
+        Ok(())
+    })
+    .with_context(|| format!("{}: cannot write", path.display()))
 }

@@ -243,11 +243,7 @@ pub fn vocabularies_table(corpora: &LoadedCorpora, params: &BuildParams) -> Resu
     let mut everything = Corpus::default();
     for loaded in &corpora.0 {
         learned.extend(parts(loaded).into_iter().map(|(name, corpus, _)| (name, corpus)));
-        let (_, all) = split(&loaded.corpus, |_| true);
-        for take in &all.takes {
-            let labels: Option<Vec<&str>> = take.labels.as_ref().map(|l| l.iter().map(|&id| all.label(id)).collect());
-            everything.push(take.path.clone(), take.motion.clone(), labels.as_deref());
-        }
+        loaded.corpus.takes.iter().for_each(|take| everything.push_from(&loaded.corpus, take));
     }
     if corpora.0.len() > 1 {
         learned.push(("all".into(), everything));

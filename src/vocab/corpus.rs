@@ -42,6 +42,12 @@ impl Corpus {
         self.takes.push(Recording { path, motion, labels });
     }
 
+    /// Adds a take of another corpus, with its labels.
+    pub fn push_from(&mut self, from: &Corpus, take: &Recording) {
+        let labels: Option<Vec<&str>> = take.labels.as_ref().map(|l| l.iter().map(|&id| from.label(id)).collect());
+        self.push(take.path.clone(), take.motion.clone(), labels.as_deref());
+    }
+
     /// The id of `label`, given a new one if it is new.
     fn label_id(&mut self, label: &str) -> u32 {
         let id = self.label_names.iter().position(|n| n == label).unwrap_or_else(|| {

@@ -39,9 +39,8 @@ pub struct GroupCheck {
 pub fn split(corpus: &Corpus, held_out: impl Fn(&Recording) -> bool) -> (Corpus, Corpus) {
     let (mut rest, mut picked) = (Corpus::default(), Corpus::default());
     for take in &corpus.takes {
-        let labels: Option<Vec<&str>> = take.labels.as_ref().map(|l| l.iter().map(|&id| corpus.label(id)).collect());
         let part = if held_out(take) { &mut picked } else { &mut rest };
-        part.push(take.path.clone(), take.motion.clone(), labels.as_deref());
+        part.push_from(corpus, take);
     }
     (rest, picked)
 }
