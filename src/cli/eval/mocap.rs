@@ -19,7 +19,7 @@ use serde_json::json;
 use std::path::Path;
 
 /// Particles per primitive of the held-out-style trial.
-const PARTICLES: &str = "25";
+const PARTICLES: usize = 25;
 
 /// The section's tables and its tracking trial; nothing when `root` holds
 /// no corpus folder.
@@ -59,6 +59,7 @@ fn held_out_tracking(work: &Work, selection: &TrackingSelection) -> anyhow::Resu
     let styles_work = work.with_vocab(vocab);
     let mut settings = Vec::new();
     let (mut rows, mut metrics) = (Vec::new(), Vec::new());
+    let particles = PARTICLES.to_string();
     for (activity, take) in &selection.tracked {
         let bvh = read_bvh(take)?;
         let motion = Retargeter::new(&bvh, &RetargetOptions::default())
@@ -70,9 +71,9 @@ fn held_out_tracking(work: &Work, selection: &TrackingSelection) -> anyhow::Resu
         metrics.push(json!({"activity": activity, "take": file, "latent_projection_mm": projected}));
         for camera in ["front", "side"] {
             let video = styles_work.render(&format!("mocap-{camera}-{activity}"), take, &selection.labels, camera)?;
-            let params = json!({"camera": camera, "activity": activity, "take": file, "particles": 25});
+            let params = json!({"camera": camera, "activity": activity, "take": file, "particles": PARTICLES});
             let label = Label { series: camera, x: activity.clone(), params };
-            settings.push(styles_work.setting(&video, label, &["--particles", PARTICLES, "--feedback"])?);
+            settings.push(styles_work.setting(&video, label, &["--particles", &particles, "--feedback"])?);
         }
     }
     work.absorb(styles_work);
