@@ -47,8 +47,13 @@ fn limb_directions_of_every_real_capture_match_within_two_degrees_on_average_and
 fn every_real_capture_stands_upright_on_the_ground_after_retargeting() {
     // Bandai's takes hold positions on every joint, the hips' far from
     // their OFFSET: read as deltas they would float a body-height up.
-    let files = ["real", "bandai", "m21"].into_iter().flat_map(common::shared_bvh_files);
-    for path in files {
+    // People crouch and bend, but none of the real captures lies down; the
+    // corpora's styles also lean into a sprint (`bandai` `dash`: 39°) or
+    // swim (`m21` `swim`: 31°), still upright.
+    let corpora = [("real", 25.0), ("bandai", 45.0), ("m21", 45.0)];
+    let files =
+        corpora.into_iter().flat_map(|(c, tilt)| common::shared_bvh_files(c).into_iter().map(move |p| (p, tilt)));
+    for (path, most_tilt) in files {
         let bvh = read_bvh(&path).unwrap();
         let (_, motion) = retarget(&bvh);
         let name = path.display();
@@ -61,10 +66,8 @@ fn every_real_capture_stands_upright_on_the_ground_after_retargeting() {
             lowest_foot = lowest_foot.min(frame.position(Joint::LeftAnkle).y).min(frame.position(Joint::RightAnkle).y);
         }
         tilts.sort_by(f64::total_cmp);
-        // People crouch, bend and lean into a sprint (`dash`: 39°), but none
-        // of these captures lies down.
         let median = tilts[tilts.len() / 2];
-        assert!(median < 45.0, "{name}: median trunk tilt {median:.1}°");
+        assert!(median < most_tilt, "{name}: median trunk tilt {median:.1}°");
         // Ankles sit 7 cm above the floor on the canonical body.
         assert!((-0.15..0.35).contains(&lowest_foot), "{name}: lowest ankle at {lowest_foot:.3} m");
     }

@@ -10,12 +10,8 @@ use imitate::vocab::evaluate::{
 };
 use imitate::vocab::pipeline::{Build, BuildParams, build};
 
-fn defaults() -> BuildParams {
-    BuildParams::standard()
-}
-
 fn learn(corpus: &Corpus) -> Build {
-    build(corpus, &defaults(), |_| {}).unwrap()
+    build(corpus, &BuildParams::standard(), |_| {}).unwrap()
 }
 
 #[test]
@@ -44,7 +40,7 @@ fn fields_and_progress_hold_on_held_out_repetitions() {
         // Other repetitions at other speeds.
         let held_out = held_out_stream(s);
         let b = learn(&training);
-        let report = check_held_out(&b, &training, &held_out, &defaults()).unwrap();
+        let report = check_held_out(&b, &training, &held_out, &BuildParams::standard()).unwrap();
         assert!(report.unmatched.iter().all(|m| m == "rest"), "seed {s}: {:?}", report.unmatched);
         let moving = report.repetitions.iter().filter(|r| r.travel > 0.0 && r.activity != "rest");
         let activities: std::collections::BTreeSet<&str> = moving.clone().map(|r| r.activity.as_str()).collect();

@@ -30,6 +30,15 @@ pub fn real_bvh_files() -> Vec<PathBuf> {
     shared_bvh_files("real")
 }
 
+/// How many takes each corpus of `../shared/mocap` holds at least.
+fn expected_takes(corpus: &str) -> usize {
+    match corpus {
+        "real" => 20,
+        "bandai" => 300,
+        _ => 10,
+    }
+}
+
 /// Every `.bvh` file of `../shared/mocap/CORPUS`, sorted by name; empty when
 /// the folder is absent outside CI.
 pub fn shared_bvh_files(corpus: &str) -> Vec<PathBuf> {
@@ -42,7 +51,7 @@ pub fn shared_bvh_files(corpus: &str) -> Vec<PathBuf> {
         .filter(|p| p.extension().is_some_and(|e| e == "bvh"))
         .collect();
     files.sort();
-    assert!(files.len() >= 10, "expected the real captures in {}", dir.display());
+    assert!(files.len() >= expected_takes(corpus), "expected the real captures in {}", dir.display());
     files
 }
 
