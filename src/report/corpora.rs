@@ -9,7 +9,7 @@ use super::eval::Table;
 use crate::mocap::bvh::read_bvh;
 use crate::mocap::fidelity::{Continuity, DirectionErrors, ThighFacing};
 use crate::mocap::retarget::{RetargetOptions, Retargeter};
-use crate::vocab::corpus::{Corpus, CorpusError, file_name, load, read_label_column, read_labels};
+use crate::vocab::corpus::{Corpus, CorpusError, expand_inputs, file_name, load, read_label_column, read_labels};
 use crate::vocab::evaluate::{activities_without_primitive, cluster_scores};
 use crate::vocab::holdout::{leave_one_group_out, split};
 use crate::vocab::pipeline::{BuildError, BuildParams, build};
@@ -47,7 +47,11 @@ pub fn corpus_folders(root: &Path) -> Result<Vec<CorpusFolder>, CorpusError> {
         if !labels.is_file() {
             continue;
         }
-        let Ok(files) = crate::vocab::corpus::expand_inputs(std::slice::from_ref(&dir)) else { continue };
+        let files = match expand_inputs(std::slice::from_ref(&dir)) {
+            Ok(files) => files,
+            Err(CorpusError::EmptyFolder { .. }) => continue,
+            Err(e) => return Err(e),
+        };
         let name = dir.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
         folders.push(CorpusFolder { name, labels, files });
     }
@@ -193,8 +197,10 @@ fn load_folder(folder: &CorpusFolder) -> Result<Loaded, CorpusError> {
     let labels = read_labels(&folder.labels)?;
     let shown = folder.labels.display().to_string();
     let corpus = load(&folder.files, &RetargetOptions::default(), Some((&labels, &shown)))?;
-    let column = |c: &str| read_label_column(&folder.labels, c).unwrap_or_default();
-    Ok(Loaded { name: folder.name.clone(), corpus, datasets: column("dataset"), styles: column("style") })
+    // A labels file without the column has no datasets (or styles); a
+    // damaged one is an error, not an empty column.
+    let column = |c: &str| read_label_column(&folder.labels, c).map(Option::unwrap_or_default);
+    Ok(Loaded { name: folder.name.clone(), corpus, datasets: column("dataset")?, styles: column("style")? })
 }
 
 /// A corpus, or one of its datasets: a name, its takes, their styles.
@@ -308,8 +314,9 @@ pub fn vocabularies_table(corpora: &LoadedCorpora, params: &BuildParams) -> Resu
 }
 
 /// Each performance style held out in turn, in every dataset (or corpus,
-/// without datasets) whose labels name at least three styles: a vocabulary learned from the other
-/// styles, checked on the held-out takes.
+/// without datasets) whose labels name at least three styles: a
+/// vocabulary learned from the other styles, checked on the held-out
+/// takes.
 pub fn held_out_table(corpora: &LoadedCorpora, params: &BuildParams) -> Result<Table, CorporaError> {
     let mut rows = Vec::new();
     let mut metrics = Vec::new();
@@ -368,9 +375,9 @@ pub fn held_out_table(corpora: &LoadedCorpora, params: &BuildParams) -> Result<T
 }
 
 /// What the held-out-style tracking trial tracks: the dataset (or corpus)
-/// with the most takes among those with three styles or more, its first style held
-/// out, and of that style one take per activity that stays in place (a
-/// fixed camera cannot follow a walk across the room).
+/// with the most takes among those with three styles or more, its first
+/// style held out, and of that style one take per activity that stays in
+/// place (a fixed camera cannot follow a walk across the room).
 #[derive(Clone, Debug)]
 pub struct TrackingSelection {
     pub corpus: String,

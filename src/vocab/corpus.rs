@@ -202,15 +202,17 @@ fn parse_labels(text: &str, name: &str) -> Result<Labels, CorpusError> {
 
 /// Another column of a per-file labels CSV (say `style`, or `performer`),
 /// by file name: the groups a leave-one-group-out evaluation holds out.
-/// Files with an empty value are left out.
-pub fn read_label_column(path: &Path, column: &str) -> Result<BTreeMap<String, String>, CorpusError> {
+/// Files with an empty value are left out; `None` when the header has no
+/// such column.
+pub fn read_label_column(path: &Path, column: &str) -> Result<Option<BTreeMap<String, String>>, CorpusError> {
     let (text, name) = read_text(path)?;
     label_column(&text, &name, column)
 }
 
-fn label_column(text: &str, name: &str, column: &str) -> Result<BTreeMap<String, String>, CorpusError> {
+fn label_column(text: &str, name: &str, column: &str) -> Result<Option<BTreeMap<String, String>>, CorpusError> {
     let csv = Csv::parse(text, name)?;
-    let (file, wanted) = (csv.require("file")?, csv.require(column)?);
+    let file = csv.require("file")?;
+    let Some(wanted) = csv.find(column) else { return Ok(None) };
     let mut out = BTreeMap::new();
     for &(i, line) in &csv.rows {
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
@@ -221,7 +223,7 @@ fn label_column(text: &str, name: &str, column: &str) -> Result<BTreeMap<String,
             out.insert(file_name(f), v.to_string());
         }
     }
-    Ok(out)
+    Ok(Some(out))
 }
 
 /// The last component of a path, which labels files use to name takes.
@@ -334,15 +336,16 @@ mod tests {
     }
 
     #[test]
-    fn another_column_is_read_by_file_name_and_empty_values_are_left_out() {
+    fn another_column_is_read_by_file_name_an_absent_one_is_none_and_a_bad_row_is_named() {
         let text = "file,activity,style\nsub/a.bvh,walk,elderly\nb.bvh,run,\n\nc.bvh,run,normal\n";
-        let styles = label_column(text, "l.csv", "style").unwrap();
+        let styles = label_column(text, "l.csv", "style").unwrap().unwrap();
         assert_eq!(
             styles.into_iter().collect::<Vec<_>>(),
             [("a.bvh".into(), "elderly".into()), ("c.bvh".into(), "normal".into())]
         );
-        let err = label_column(text, "l.csv", "performer").unwrap_err().to_string();
-        assert_eq!(err, "l.csv:1: no `performer` column in the header `file,activity,style`");
+        assert_eq!(label_column(text, "l.csv", "performer").unwrap(), None);
+        let err = label_column("frame,activity,style\n0,walk,x\n", "l.csv", "style").unwrap_err().to_string();
+        assert_eq!(err, "l.csv:1: no `file` column in the header `frame,activity,style`");
         let err = label_column("file,style\na.bvh\n", "l.csv", "style").unwrap_err().to_string();
         assert_eq!(err, "l.csv:2: too few fields in `a.bvh`");
     }
