@@ -8,6 +8,7 @@
 use super::eval::Table;
 use crate::mocap::bvh::read_bvh;
 use crate::mocap::fidelity::{Continuity, DirectionErrors, ThighFacing};
+use crate::mocap::pose::{Motion, Pose};
 use crate::mocap::retarget::{RetargetOptions, Retargeter};
 use crate::vocab::corpus::{Corpus, CorpusError, expand_inputs, file_name, load, read_label_column, read_labels};
 use crate::vocab::evaluate::{activities_without_primitive, cluster_scores};
@@ -124,6 +125,7 @@ pub fn corpora_table(folders: &[CorpusFolder]) -> Result<Table, CorpusError> {
         let with_jumps = mapped.iter().filter(|(_, m)| m.continuity.unexplained > 0).count();
         let worst_jumps =
             mapped.iter().map(|(n, m)| (m.continuity.unexplained as f64, *n)).fold((0.0, ""), max_by_first);
+        let by_structure = mapped.iter().filter(|(_, m)| m.by_structure > 0).count();
         let within = if standing > 0 { 1.0 - beyond as f64 / standing as f64 } else { f64::NAN };
         rows.push(vec![
             name.to_string(),
@@ -131,7 +133,7 @@ pub fn corpora_table(folders: &[CorpusFolder]) -> Result<Table, CorpusError> {
             format!("{minutes:.1}"),
             skeletons.len().to_string(),
             format!("{} of {}", mapped.len(), files.len()),
-            mapped.iter().filter(|(_, m)| m.by_structure > 0).count().to_string(),
+            by_structure.to_string(),
             format!("{direction_mean:.3} ({:.2}, {})", worst_direction.0, worst_direction.1),
             format!("{:.1}% of {standing} ({:.0}°, {})", 100.0 * within, worst_thigh.0, worst_thigh.1),
             format!("{jumps} in {with_jumps} takes ({:.0}, {})", worst_jumps.0, worst_jumps.1),
@@ -143,7 +145,7 @@ pub fn corpora_table(folders: &[CorpusFolder]) -> Result<Table, CorpusError> {
             "minutes": minutes,
             "skeletons": skeletons.len(),
             "mapped": mapped.len(),
-            "mapped_by_structure": mapped.iter().filter(|(_, m)| m.by_structure > 0).count(),
+            "mapped_by_structure": by_structure,
             "limb_direction_mean_deg": direction_mean,
             "limb_direction_worst_take": {"take": worst_direction.1, "mean_deg": worst_direction.0},
             "standing_leg_frames": standing,
@@ -385,8 +387,17 @@ pub struct TrackingSelection {
     pub held_out: String,
     /// The other styles' takes, to learn from.
     pub training: Vec<PathBuf>,
-    /// (activity, take) to track, by activity.
-    pub tracked: Vec<(String, PathBuf)>,
+    /// The takes to track, by activity.
+    pub tracked: Vec<TrackedTake>,
+}
+
+/// One take of the held-out style to track, with its motion as the corpus
+/// read and retargeted it.
+#[derive(Clone, Debug)]
+pub struct TrackedTake {
+    pub activity: String,
+    pub path: PathBuf,
+    pub motion: Motion,
 }
 
 /// How far the root may wander from where a take starts (m) for the take
@@ -404,7 +415,7 @@ pub fn tracking_selection(corpora: &LoadedCorpora, folders: &[CorpusFolder]) -> 
             if present.len() < 3 || best.as_ref().is_some_and(|(n, _)| *n >= corpus.takes.len()) {
                 continue;
             }
-            let mut tracked: BTreeMap<String, PathBuf> = BTreeMap::new();
+            let mut tracked: BTreeMap<String, TrackedTake> = BTreeMap::new();
             let mut training = Vec::new();
             for take in &corpus.takes {
                 if style_of(&take.path) != Some(held_out) {
@@ -413,9 +424,14 @@ pub fn tracking_selection(corpora: &LoadedCorpora, folders: &[CorpusFolder]) -> 
                 }
                 let Some(&label) = take.labels.as_ref().and_then(|l| l.first()) else { continue };
                 let start = take.motion.poses.first().map(|p| p.root).unwrap_or_default();
-                let wander = |p: &crate::mocap::pose::Pose| (p.root - start).with_y(0.0).length();
+                let wander = |p: &Pose| (p.root - start).with_y(0.0).length();
                 if take.motion.poses.iter().all(|p| wander(p) < IN_PLACE_M) {
-                    tracked.entry(corpus.label(label).to_string()).or_insert_with(|| PathBuf::from(&take.path));
+                    let activity = corpus.label(label).to_string();
+                    tracked.entry(activity.clone()).or_insert_with(|| TrackedTake {
+                        activity,
+                        path: PathBuf::from(&take.path),
+                        motion: take.motion.clone(),
+                    });
                 }
             }
             let selection = TrackingSelection {
@@ -423,7 +439,7 @@ pub fn tracking_selection(corpora: &LoadedCorpora, folders: &[CorpusFolder]) -> 
                 labels: folder.labels.clone(),
                 held_out: held_out.clone(),
                 training,
-                tracked: tracked.into_iter().collect(),
+                tracked: tracked.into_values().collect(),
             };
             best = Some((corpus.takes.len(), selection));
         }

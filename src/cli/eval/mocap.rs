@@ -4,11 +4,8 @@
 
 use super::{Label, Work};
 use crate::cli::{arg, invoke};
-use anyhow::Context;
-use imitate::mocap::bvh::read_bvh;
-use imitate::mocap::retarget::{RetargetOptions, Retargeter};
 use imitate::report::corpora::{
-    TrackingSelection, corpora_table, corpus_folders, held_out_table, load_corpora, tracking_selection,
+    TrackedTake, TrackingSelection, corpora_table, corpus_folders, held_out_table, load_corpora, tracking_selection,
     vocabularies_table,
 };
 use imitate::report::eval::{Measure, Table, Trial};
@@ -60,12 +57,8 @@ fn held_out_tracking(work: &Work, selection: &TrackingSelection) -> anyhow::Resu
     let mut settings = Vec::new();
     let (mut rows, mut metrics) = (Vec::new(), Vec::new());
     let particles = PARTICLES.to_string();
-    for (activity, take) in &selection.tracked {
-        let bvh = read_bvh(take)?;
-        let motion = Retargeter::new(&bvh, &RetargetOptions::default())
-            .with_context(|| format!("{}: cannot retarget", take.display()))?
-            .retarget(&bvh);
-        let projected = latent_projection_mm(vocabulary.primitives(), &motion).unwrap_or(f64::NAN);
+    for TrackedTake { activity, path: take, motion } in &selection.tracked {
+        let projected = latent_projection_mm(vocabulary.primitives(), motion).unwrap_or(f64::NAN);
         let file = take.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
         rows.push(vec![activity.clone(), file.clone(), format!("{projected:.1}")]);
         metrics.push(json!({"activity": activity, "take": file, "latent_projection_mm": projected}));
