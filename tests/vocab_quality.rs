@@ -96,3 +96,28 @@ fn real_captures_cluster_with_purity_of_at_least_0_8() {
         assert!(p.progress(&y).is_finite());
     }
 }
+
+#[test]
+fn bandai_dataset_2_gives_each_of_its_ten_activities_primitives_of_its_own() {
+    let files: Vec<_> = common::shared_bvh_files("bandai")
+        .into_iter()
+        .filter(|f| f.file_name().is_some_and(|n| n.to_string_lossy().starts_with("dataset-2_")))
+        .collect();
+    let Some(dir) = files.first().and_then(|f| f.parent()) else { return };
+    let labels = read_labels(&dir.join("labels.csv")).unwrap();
+    let corpus = load(&files, &Default::default(), Some((&labels, "labels.csv"))).unwrap();
+    assert_eq!(corpus.takes.len(), 240);
+    let b = learn(&corpus);
+    // The vocabulary's partition is its primitives: the clusters split by
+    // how the root moves (walks that turn left, go straight, turn right).
+    let primitives = b.fitted.assignments(&b.clustering);
+    let scores = cluster_scores(&b.segments, &primitives).unwrap().all;
+    assert!(scores.purity >= 0.90, "purity {:.3}", scores.purity);
+    let parts = primitives.iter().max().unwrap() + 1;
+    let missing = activities_without_primitive(&b.segments, &primitives, parts);
+    assert!(missing.is_empty(), "no primitive of its own for {missing:?}");
+    let names: Vec<&str> = b.fitted.primitives.iter().map(|p| p.name()).collect();
+    for turn in ["walk-turn-left", "walk-turn-right"] {
+        assert!(names.contains(&turn), "no primitive named {turn} in {names:?}");
+    }
+}

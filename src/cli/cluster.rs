@@ -72,7 +72,7 @@ pub fn cluster(mut embedded: Embedded, params: &ValidClusterParams, global: Glob
         );
         let missing = activities_without_primitive(rows, clustering.assignments(), clustering.k());
         if !missing.is_empty() {
-            note(global, &format!("no primitive of its own for: {}", missing.join(", ")));
+            note(global, &format!("no cluster of its own for: {}", missing.join(", ")));
         }
     }
     embedded.segments.lineage.cluster = Some(ClusterRecord::new(params.params().clone(), &clustering));

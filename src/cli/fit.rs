@@ -4,13 +4,16 @@ use super::learn::FitArgs;
 use super::{Global, Outcome, note, progress};
 use anyhow::Context;
 use imitate::vocab::corpus::Corpus;
+use imitate::vocab::evaluate::{activities_without_primitive, cluster_scores};
 use imitate::vocab::pipeline::fit_primitives;
 use imitate::vocab::primitive::ValidFitParams;
 use imitate::vocab::stages::{Clustered, build_info, write_primitives};
 use imitate::vocab::vocabulary::Vocabulary;
 use std::path::PathBuf;
 
-/// Fit a primitive to each cluster: a PCA latent space (as many
+/// Fit primitives to each cluster (more than one where its segments' root
+/// moves in different ways, as a walk turning left and one going straight,
+/// or its swings travel one path both ways): a PCA latent space (as many
 /// dimensions as keep `--variance` of the pose variance, within
 /// `--min-dims` and `--max-dims`), a gradient field over the training poses'
 /// k nearest neighbours, speed statistics, and attractor progress (phase
@@ -42,6 +45,26 @@ pub fn fit(
     for name in &fitted.still {
         note(global, &format!("cluster `{name}` left out: its poses never change, so it has no motion to model"));
     }
+    let assignments = fitted.assignments(&clustered.clustering);
+    if let Some(scores) = cluster_scores(&segments.rows, &assignments) {
+        let parts = assignments.iter().max().map_or(0, |m| m + 1);
+        let missing = activities_without_primitive(&segments.rows, &assignments, parts);
+        let missing = if missing.is_empty() {
+            String::new()
+        } else {
+            format!("; no primitive of its own for: {}", missing.join(", "))
+        };
+        note(
+            global,
+            &format!(
+                "{} primitives against the labels: purity {:.3}, adjusted Rand index {:.3} over all {} segments{missing}",
+                fitted.primitives.len(),
+                scores.all.purity,
+                scores.all.adjusted_rand_index,
+                scores.all.segments
+            ),
+        );
+    }
     let info = build_info(&segments.lineage, params.params(), segments, fitted.still);
     let vocabulary = Vocabulary::new(fitted.primitives, info);
     note(global, &summary(&vocabulary));
@@ -50,13 +73,14 @@ pub fn fit(
 
 /// One line per primitive.
 pub fn summary(vocabulary: &Vocabulary) -> String {
+    let width = vocabulary.primitives().iter().map(|p| p.name().chars().count()).max().unwrap_or(0).max(16);
     let mut lines = vec![format!(
-        "{:<16} {:>4} {:>9} {:>7} {:>9} {:>12}",
+        "{:<width$} {:>4} {:>9} {:>7} {:>9} {:>12}",
         "primitive", "dims", "variance", "frames", "segments", "speed (1/s)"
     )];
     for p in vocabulary.primitives() {
         lines.push(format!(
-            "{:<16} {:>4} {:>8.1}% {:>7} {:>9} {:>12.2}",
+            "{:<width$} {:>4} {:>8.1}% {:>7} {:>9} {:>12.2}",
             p.name(),
             p.dims(),
             100.0 * p.variance_kept(),

@@ -261,9 +261,12 @@ pub fn vocabularies_table(corpora: &LoadedCorpora, params: &BuildParams) -> Resu
     for (name, corpus) in &learned {
         let built =
             build(corpus, params, |_| {}).map_err(|source| CorporaError::Build { name: name.clone(), source })?;
-        let assignments = built.clustering.assignments();
-        let scores = cluster_scores(&built.segments, assignments).map(|s| s.all);
-        let missing = activities_without_primitive(&built.segments, assignments, built.clustering.k());
+        // The vocabulary's own partition: its primitives, which split
+        // clusters by root motion and direction (see `fit_primitives`).
+        let assignments = built.fitted.assignments(&built.clustering);
+        let parts = assignments.iter().max().map_or(0, |m| m + 1);
+        let scores = cluster_scores(&built.segments, &assignments).map(|s| s.all);
+        let missing = activities_without_primitive(&built.segments, &assignments, parts);
         let activities: BTreeSet<&str> = built.segments.iter().filter_map(|r| r.label.as_deref()).collect();
         let cell = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{v:.3}"));
         rows.push(vec![
@@ -293,9 +296,10 @@ pub fn vocabularies_table(corpora: &LoadedCorpora, params: &BuildParams) -> Resu
         key: "mocap_vocabularies".into(),
         title: "Real motion capture: vocabularies".into(),
         about: "A vocabulary learned (`vocab build`'s defaults) from each corpus, each of its datasets, and all of \
-                them together; its clusters against the activity labels over every labelled segment (labels never \
-                reach learning). An activity has a primitive of its own when it holds more than half of some \
-                cluster's segments."
+                them together; its primitives (k clusters, split where their segments' root moves in different ways \
+                or their swings travel one path both ways) against the activity labels over every labelled \
+                segment (labels never reach learning). An activity has a primitive of its own when it holds more \
+                than half of some primitive's segments."
             .into(),
         columns: [
             "learned from",

@@ -11,7 +11,7 @@ use crate::vocab::corpus::Corpus;
 use crate::vocab::metrics::{adjusted_rand_index, cosine, majority_labels, purity, spearman};
 use crate::vocab::phase::{ArcPath, PhaseAxes};
 use crate::vocab::pipeline::{
-    Build, BuildError, BuildParams, SegmentRow, segment_corpus_along, segment_vectors, training_segments,
+    Build, BuildError, BuildParams, SegmentRow, root_classes, segment_corpus_along, segment_vectors, training_segments,
 };
 use crate::vocab::primitive::{Field, FitError, Primitive, ValidFitParams};
 use crate::vocab::segment::Span;
@@ -261,15 +261,23 @@ pub fn check_held_out(
     // The primitive fitted to each training segment's cluster, if any.
     let primitive_of: Vec<Option<usize>> =
         (0..build.segments.len()).map(|i| fitted.members.iter().position(|m| m.contains(&i))).collect();
+    let classes = root_classes(held_out, &rows);
     let activities: BTreeSet<&str> = fitted.primitives.iter().map(|p| activity_of(p.name())).collect();
     let repetitions: Vec<RepetitionCheck> = rows
         .par_iter()
         .zip(&fresh)
-        .filter(|(r, _)| r.label.is_some() && r.label_share >= WHOLE_ACTIVITY_SHARE)
-        .filter_map(|(r, vector)| {
-            let (_, p) = (0..known.len()).filter_map(|i| primitive_of[i].map(|p| (i, p))).min_by(|a, b| {
-                squared_distance(vector, &known[a.0]).total_cmp(&squared_distance(vector, &known[b.0]))
-            })?;
+        .zip(&classes)
+        .filter(|((r, _), _)| r.label.is_some() && r.label_share >= WHOLE_ACTIVITY_SHARE)
+        .filter_map(|((r, vector), class)| {
+            // Among the primitives whose root moved as this segment's did,
+            // when there are any (root_groups keeps them apart).
+            let alike = fitted.root.contains(class);
+            let (_, p) = (0..known.len())
+                .filter_map(|i| primitive_of[i].map(|p| (i, p)))
+                .filter(|&(_, p)| !alike || fitted.root[p] == *class)
+                .min_by(|a, b| {
+                    squared_distance(vector, &known[a.0]).total_cmp(&squared_distance(vector, &known[b.0]))
+                })?;
             let motion = &held_out.takes[r.take].motion;
             let mut check = check_repetition(&fitted.primitives[p], &joint_fields[p], motion, r.span);
             check.activity = r.label.clone().expect("filtered to labelled segments");

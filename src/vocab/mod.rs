@@ -16,6 +16,7 @@ pub mod pca;
 pub mod phase;
 pub mod pipeline;
 pub mod primitive;
+pub mod root_motion;
 pub mod segment;
 pub mod stages;
 pub mod table;

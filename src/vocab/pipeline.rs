@@ -8,6 +8,7 @@ use crate::vocab::embed::{EmbedError, Embedding, ValidEmbedParams, resample};
 use crate::vocab::metrics::majority_labels;
 use crate::vocab::phase::PhaseAxes;
 use crate::vocab::primitive::{FitError, Primitive, TrainingSegment, ValidFitParams};
+use crate::vocab::root_motion::{RootClass, RootMotion, root_groups};
 use crate::vocab::segment::{Cut, Span, ValidSegmentParams, segment_motion};
 use rayon::prelude::*;
 
@@ -116,12 +117,12 @@ pub fn embed_segments(
     Ok(params.embed(&vectors, &next)?)
 }
 
-/// Primitive names: each cluster's majority label (held by more than half
-/// its labelled segments), else `p<i>` for cluster `i`; not yet unique.
-pub fn primitive_names(rows: &[SegmentRow], clustering: &Clustering) -> Vec<String> {
-    let labels: Vec<Option<&str>> = rows.iter().map(|r| r.label.as_deref()).collect();
-    let majorities = majority_labels(clustering.assignments(), &labels, clustering.k());
-    majorities.iter().enumerate().map(|(i, m)| m.map_or_else(|| format!("p{i}"), str::to_string)).collect()
+/// A group's name: the label held by more than half of its labelled
+/// segments, else `p<cluster>`; not yet unique.
+fn group_name(rows: &[SegmentRow], cluster: usize, members: &[usize]) -> String {
+    let labels: Vec<Option<&str>> = members.iter().map(|&i| rows[i].label.as_deref()).collect();
+    let majority = majority_labels(&vec![0; members.len()], &labels, 1)[0];
+    majority.map_or_else(|| format!("p{cluster}"), str::to_string)
 }
 
 /// Names made unique: a repeated name gets `-2`, `-3`, ….
@@ -200,46 +201,76 @@ fn direction_groups(corpus: &Corpus, rows: &[SegmentRow], members: &[usize]) -> 
     if back.len() >= 2 && forward_swings >= 2 { vec![forward, back] } else { vec![members.to_vec()] }
 }
 
+/// A root group needs this many segments; rarer root motions join their
+/// cluster's most common one (see [`root_groups`]).
+const MIN_ROOT_GROUP: usize = 2;
+
 /// The primitives fitted to a clustering.
 pub struct Fitted {
     /// In cluster order, without the clusters of still segments.
     pub primitives: Vec<Primitive>,
     /// The segments (indices into the rows) each primitive was fitted to.
     pub members: Vec<Vec<usize>>,
+    /// How the root moved around each primitive's segments.
+    pub root: Vec<RootClass>,
     /// Names of clusters left out because their poses never change: with
     /// no motion there is no gradient field to learn.
     pub still: Vec<String>,
 }
 
-/// Fits a primitive to each cluster (in parallel), in cluster order; a
-/// cluster whose swings travel one path both ways gives one primitive per
-/// direction ([`direction_groups`]), the second named like a repeat.
+impl Fitted {
+    /// Each segment's primitive; a segment of a still cluster (left out)
+    /// gets `primitives + cluster`, so the segments of one such cluster
+    /// stay together when a partition is scored.
+    pub fn assignments(&self, clustering: &Clustering) -> Vec<usize> {
+        let mut of: Vec<usize> = clustering.assignments().iter().map(|c| self.primitives.len() + c).collect();
+        for (p, members) in self.members.iter().enumerate() {
+            members.iter().for_each(|&i| of[i] = p);
+        }
+        of
+    }
+}
+
+/// Each segment's root class ([`RootMotion::around`]).
+pub fn root_classes(corpus: &Corpus, rows: &[SegmentRow]) -> Vec<RootClass> {
+    rows.par_iter().map(|r| RootMotion::around(&corpus.takes[r.take].motion, r.span).class()).collect()
+}
+
+/// Fits primitives to each cluster (in parallel), in cluster order. A
+/// cluster is first split by how the root moved around its segments
+/// ([`root_groups`]: joint space alone cannot tell a walk that turns from
+/// one that goes straight), then each part by the way its swings travel
+/// ([`direction_groups`]); each group is a primitive, named by its own
+/// segments' majority label (a repeated name numbered).
 pub fn fit_primitives(
     corpus: &Corpus,
     rows: &[SegmentRow],
     clustering: &Clustering,
     params: &ValidFitParams,
 ) -> Result<Fitted, BuildError> {
-    let cluster_names = primitive_names(rows, clustering);
-    let groups: Vec<(usize, Vec<usize>)> = (0..clustering.k())
+    let classes = root_classes(corpus, rows);
+    let groups: Vec<(usize, RootClass, Vec<usize>)> = (0..clustering.k())
         .into_par_iter()
         .flat_map_iter(|c| {
             let members: Vec<usize> = (0..rows.len()).filter(|&i| clustering.assignments()[i] == c).collect();
-            direction_groups(corpus, rows, &members).into_iter().map(move |g| (c, g))
+            root_groups(&members, &classes, MIN_ROOT_GROUP).into_iter().flat_map(move |(class, part)| {
+                direction_groups(corpus, rows, &part).into_iter().map(move |g| (c, class, g))
+            })
         })
         .collect();
-    let names = unique_names(groups.iter().map(|(c, _)| cluster_names[*c].clone()));
+    let names = unique_names(groups.iter().map(|(c, _, members)| group_name(rows, *c, members)));
     let results: Vec<Result<Primitive, FitError>> = groups
         .par_iter()
         .zip(&names)
-        .map(|((_, members), name)| params.fit(name, &training_segments(corpus, rows, members)))
+        .map(|((_, _, members), name)| params.fit(name, &training_segments(corpus, rows, members)))
         .collect();
-    let mut fitted = Fitted { primitives: Vec::new(), members: Vec::new(), still: Vec::new() };
-    for ((_, members), result) in groups.into_iter().zip(results) {
+    let mut fitted = Fitted { primitives: Vec::new(), members: Vec::new(), root: Vec::new(), still: Vec::new() };
+    for ((_, class, members), result) in groups.into_iter().zip(results) {
         match result {
             Ok(primitive) => {
                 fitted.primitives.push(primitive);
                 fitted.members.push(members);
+                fitted.root.push(class);
             }
             Err(FitError::Motionless(name)) => fitted.still.push(name),
             Err(other) => return Err(other.into()),
@@ -296,8 +327,10 @@ pub fn build(corpus: &Corpus, params: &BuildParams, mut stage: impl FnMut(&str))
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mocap::body::Body;
+    use crate::mocap::body::{Body, Joint};
     use crate::mocap::pose::{Motion, Pose};
+    use crate::vocab::cluster::Choice;
+    use crate::vocab::root_motion::{Travel, Turn};
 
     /// One take of `swings` 20-frame swings along one curved path in joint
     /// space, alternately out (rest to raised) and back when `both_ways`,
@@ -325,6 +358,51 @@ mod tests {
         let mut corpus = Corpus::default();
         corpus.push("swings.bvh".into(), Motion { body, frame_time_s: 1.0 / 30.0, poses }, None);
         (corpus, rows)
+    }
+
+    /// A labelled take of `cycles` 30-frame leg swings (out and back along
+    /// one path, as cycles) while the root walks forward at 1.2 m/s and
+    /// turns at `turn` rad/s.
+    fn walk(corpus: &mut Corpus, rows: &mut Vec<SegmentRow>, file: &str, label: &str, cycles: usize, turn: f64) {
+        let body = Body::standard();
+        let dt = 1.0 / 30.0;
+        let mut pose = Pose::rest(&body);
+        let mut poses = Vec::new();
+        let take = corpus.takes.len();
+        for c in 0..cycles {
+            let first = poses.len();
+            for f in 0..30 {
+                let swing = (std::f64::consts::TAU * f as f64 / 30.0).sin() * (1.0 + 0.02 * c as f64);
+                pose.x[Joint::LeftHip.dof_offset()] = 0.5 * swing;
+                pose.x[Joint::RightHip.dof_offset()] = -0.5 * swing;
+                poses.push(pose);
+                let (sin, cos) = pose.heading.sin_cos();
+                pose.root += glam::DVec3::new(sin, 0.0, cos) * 1.2 * dt;
+                pose.heading += turn * dt;
+            }
+            let span = Span { first, last: poses.len() - 1 };
+            rows.push(SegmentRow { take, span, phase_offset: Some(0.0), label: Some(label.into()), label_share: 1.0 });
+        }
+        let labels = vec![label; poses.len()];
+        corpus.push(file.into(), Motion { body, frame_time_s: dt, poses }, Some(&labels));
+    }
+
+    #[test]
+    fn a_cluster_of_steps_is_split_by_how_the_root_turns_and_each_part_named_by_its_own_labels() {
+        let (mut corpus, mut rows) = (Corpus::default(), Vec::new());
+        walk(&mut corpus, &mut rows, "a.bvh", "walk", 4, 0.0);
+        walk(&mut corpus, &mut rows, "b.bvh", "walk-turn-left", 4, 0.6);
+        walk(&mut corpus, &mut rows, "c.bvh", "walk", 4, 0.0);
+        // One cluster: the legs move alike in all three takes.
+        let clustering = Clustering::recorded(vec![0; rows.len()], Choice::Given, Vec::new());
+        let params = crate::vocab::primitive::FitParams::new().check().unwrap();
+        let fitted = fit_primitives(&corpus, &rows, &clustering, &params).unwrap();
+        let names: Vec<&str> = fitted.primitives.iter().map(|p| p.name()).collect();
+        assert_eq!(names, ["walk", "walk-turn-left"]);
+        assert_eq!(fitted.members, [vec![0, 1, 2, 3, 8, 9, 10, 11], vec![4, 5, 6, 7]]);
+        let forward = |turn| RootClass { turn, travel: Travel::Forward };
+        assert_eq!(fitted.root, [forward(Turn::Straight), forward(Turn::Left)]);
+        assert_eq!(fitted.assignments(&clustering), [0, 0, 0, 0, 1, 1, 1, 1, 0, 0, 0, 0]);
     }
 
     #[test]
