@@ -122,7 +122,8 @@ pub struct Continuity {
     pub worst_jump_deg: f64,
     pub worst_joint: &'static str,
     pub worst_frame: usize,
-    /// How far the source bones at that joint turned over that frame.
+    /// How far the source bones at that joint turned over that frame (or
+    /// the angle between the joint's bone and its parent's changed).
     pub worst_source_deg: f64,
     /// Jumps over 60° where the source's bones at the joint turned less.
     pub unexplained: usize,
@@ -131,7 +132,7 @@ pub struct Continuity {
 impl Continuity {
     /// Compares `motion` (retargeted from `bvh` by `retargeter`) frame to
     /// frame with the source's bones: a joint's own bone, its parent's and
-    /// its child's.
+    /// its child's, and the angle between its bone and its parent's.
     pub fn measure(bvh: &Bvh, retargeter: &Retargeter, motion: &Motion) -> Continuity {
         let mut scratch = vec![Transform::default(); bvh.skeleton.joints.len()];
         let bone = |points: &[Option<DVec3>; Landmark::COUNT], j: Joint| -> Option<DVec3> {
@@ -153,12 +154,18 @@ impl Continuity {
             let points = retargeter.source_landmarks(bvh.frame(t), &mut scratch);
             let turned = |j: Joint| -> f64 {
                 let neighbours = [Some(j), j.parent(), j.bone_child()];
-                neighbours
+                let own = neighbours
                     .into_iter()
                     .flatten()
                     .filter_map(|k| Some(bone(&previous, k)?.angle_between(bone(&points, k)?)))
-                    .fold(0.0, f64::max)
-                    .to_degrees()
+                    .fold(0.0, f64::max);
+                // A joint that bends (a punch straightening the elbow) turns
+                // by as much as the angle between its bone and its parent's
+                // changes, which can exceed either bone's own turn.
+                let bend =
+                    |at: &[Option<DVec3>; Landmark::COUNT]| Some(bone(at, j)?.angle_between(bone(at, j.parent()?)?));
+                let bent = bend(&previous).zip(bend(&points)).map_or(0.0, |(a, b)| (b - a).abs());
+                own.max(bent).to_degrees()
             };
             for j in Joint::ALL.into_iter().filter(|&j| j != Joint::Pelvis) {
                 let (a, b) = (motion.poses[t - 1].joint(j), motion.poses[t].joint(j));
