@@ -70,7 +70,7 @@ pub fn cluster(mut embedded: Embedded, params: &ValidClusterParams, global: Glob
                 all.segments
             ),
         );
-        let missing = activities_without_primitive(rows, clustering.assignments(), clustering.k());
+        let missing = activities_without_primitive(rows, clustering.assignments());
         if !missing.is_empty() {
             note(global, &format!("no cluster of its own for: {}", missing.join(", ")));
         }

@@ -47,8 +47,7 @@ pub fn fit(
     }
     let assignments = fitted.assignments(&clustered.clustering);
     if let Some(scores) = cluster_scores(&segments.rows, &assignments) {
-        let parts = assignments.iter().max().map_or(0, |m| m + 1);
-        let missing = activities_without_primitive(&segments.rows, &assignments, parts);
+        let missing = activities_without_primitive(&segments.rows, &assignments);
         let missing = if missing.is_empty() {
             String::new()
         } else {

@@ -264,9 +264,8 @@ pub fn vocabularies_table(corpora: &LoadedCorpora, params: &BuildParams) -> Resu
         // The vocabulary's own partition: its primitives, which split
         // clusters by root motion and direction (see `fit_primitives`).
         let assignments = built.fitted.assignments(&built.clustering);
-        let parts = assignments.iter().max().map_or(0, |m| m + 1);
         let scores = cluster_scores(&built.segments, &assignments).map(|s| s.all);
-        let missing = activities_without_primitive(&built.segments, &assignments, parts);
+        let missing = activities_without_primitive(&built.segments, &assignments);
         let activities: BTreeSet<&str> = built.segments.iter().filter_map(|r| r.label.as_deref()).collect();
         let cell = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{v:.3}"));
         rows.push(vec![

@@ -86,11 +86,13 @@ pub fn cluster_scores(rows: &[SegmentRow], assignments: &[usize]) -> Option<Clus
     })
 }
 
-/// Labels that are not the majority label of any cluster: activities the
-/// vocabulary has no primitive of its own for.
-pub fn activities_without_primitive(rows: &[SegmentRow], assignments: &[usize], k: usize) -> Vec<String> {
+/// Labels that are not the majority label of any group of `assignments`
+/// (clusters or primitives): activities the vocabulary has no primitive of
+/// its own for.
+pub fn activities_without_primitive(rows: &[SegmentRow], assignments: &[usize]) -> Vec<String> {
     let labels: Vec<Option<&str>> = rows.iter().map(|r| r.label.as_deref()).collect();
-    let named: BTreeSet<&str> = majority_labels(assignments, &labels, k).into_iter().flatten().collect();
+    let groups = assignments.iter().max().map_or(0, |m| m + 1);
+    let named: BTreeSet<&str> = majority_labels(assignments, &labels, groups).into_iter().flatten().collect();
     let all: BTreeSet<&str> = labels.iter().flatten().copied().collect();
     all.difference(&named).map(|s| s.to_string()).collect()
 }
@@ -258,9 +260,10 @@ pub fn check_held_out(
     let (known, _) = segment_vectors(training, &build.segments, frames);
     let (fresh, _) = segment_vectors(held_out, &rows, frames);
     let fitted = &build.fitted;
-    // The primitive fitted to each training segment's cluster, if any.
+    // The primitive each training segment was fitted to, if any (not a
+    // still cluster's).
     let primitive_of: Vec<Option<usize>> =
-        (0..build.segments.len()).map(|i| fitted.members.iter().position(|m| m.contains(&i))).collect();
+        fitted.assignments(&build.clustering).into_iter().map(|p| (p < fitted.primitives.len()).then_some(p)).collect();
     let classes = root_classes(held_out, &rows);
     let activities: BTreeSet<&str> = fitted.primitives.iter().map(|p| activity_of(p.name())).collect();
     let repetitions: Vec<RepetitionCheck> = rows
