@@ -234,6 +234,44 @@ fn real_captures_render_from_every_preset() {
     }
 }
 
+/// A truth.csv's column by name, one value per frame.
+fn column(truth: &str, name: &str) -> Vec<f64> {
+    let mut lines = truth.lines();
+    let at = lines.next().unwrap().split(',').position(|c| c == name).unwrap();
+    lines.map(|l| l.split(',').nth(at).unwrap().parse().unwrap()).collect()
+}
+
+#[test]
+fn a_test_body_performs_the_take_on_its_own_skeleton_and_says_who_it_is() {
+    let tmp = tempfile::tempdir().unwrap();
+    let take = mocap("wave-h.bvh");
+    let take = take.to_str().unwrap();
+    for (name, body) in [("capsules", "capsules"), ("heavy", "heavy"), ("lanky", "lanky")] {
+        let out = render(&[take, "-o", name, "--body", body, "--noise", "none", "--color"], tmp.path());
+        assert!(out.status.success(), "{body}: {}", stderr_of(&out));
+    }
+    let dir = |name: &str| tmp.path().join(name);
+    assert!(!dir("capsules").join("body.toml").exists());
+    let heavy = imitate::vision::figure::Build::load(&dir("heavy").join("body.toml")).unwrap();
+    assert_eq!(heavy, imitate::vision::figure::Build::preset("heavy").unwrap());
+    let truth = |name: &str| fs::read_to_string(dir(name).join("truth.csv")).unwrap();
+    // Every angle kept, the skeleton the build's: the head sits as high as
+    // the build is tall, and the waving hand's path shrinks or grows with it.
+    let head = |name: &str| column(&truth(name), "head_y")[0];
+    assert!(head("heavy") < head("capsules") && head("capsules") < head("lanky"));
+    assert!((head("heavy") / head("lanky") - 1.60 / 1.95).abs() < 0.02, "{} {}", head("heavy"), head("lanky"));
+    assert_eq!(column(&truth("heavy"), "left_elbow_angle"), column(&truth("capsules"), "left_elbow_angle"));
+    // The heavy build covers more of the frame for its height than the
+    // capsules, the lanky less.
+    let cover = |name: &str| {
+        let area: usize = frames(&dir(name)).iter().map(|f| f.2.iter().filter(|&&p| p == 255).count()).sum();
+        area as f64 / head(name).powi(2)
+    };
+    let (c, h, l) = (cover("capsules"), cover("heavy"), cover("lanky"));
+    assert!(h > 1.15 * c && l < c, "cover: capsules {c}, heavy {h}, lanky {l}");
+    assert_eq!(files(&dir("heavy").join("color")).len(), frames(&dir("heavy")).len());
+}
+
 /// Runs a render that must fail: `code`, one error line holding `says`,
 /// and no file left in the working folder beyond what was there.
 fn refused(dir: &Path, args: &[&str], code: i32, says: &str) {
@@ -262,6 +300,10 @@ fn bad_input_is_refused_with_nothing_written() {
     refused(dir, &[take, "-o", "out", "--camera", "fisheye"], 2, "neither a preset");
     refused(dir, &[take, "-o", "out", "--noise", "loud"], 2, "--noise");
     refused(dir, &[take, "-o", "out", "--noise", "4"], 2, "expected none, light, medium or heavy");
+    refused(dir, &[take, "-o", "out", "--body", "giant"], 2, "no body named `giant`");
+    refused(dir, &[take, "-o", "out", "--body", "nobody.toml"], 1, "nobody.toml: cannot read");
+    fs::write(dir.join("tall.toml"), "name = \"tall\"\nheight_m = 2.6\ngirth = 1\narm_share = 1\nleg_share = 1\nhair = \"none\"\nclothing = \"fitted\"\n").unwrap();
+    refused(dir, &[take, "-o", "out", "--body", "tall.toml"], 1, "tall.toml: `height_m` is 2.6; it must be 1 to 2.3");
     let mut spec = Camera::preset(imitate::vision::camera::Preset::Front, 160, 120).unwrap().spec().clone();
     spec.up = [0.0, 0.0, 1.0];
     fs::write(dir.join("along.json"), serde_json::to_string(&spec).unwrap()).unwrap();

@@ -5,7 +5,8 @@ use super::segment::take;
 use super::{Global, Outcome, UsageError, camera, note, progress, refuse_nonempty};
 use anyhow::Context;
 use imitate::fsutil::{write_atomic, write_dir_atomic};
-use imitate::vision::color::Scene;
+use imitate::vision::color::{Scene, Surface};
+use imitate::vision::figure::{Build, BuildError};
 use imitate::vision::mask::Mask;
 use imitate::vision::noise::{Level, Noise};
 use imitate::vision::render::draw;
@@ -17,13 +18,14 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 /// Render a BVH take (any skeleton: it is retargeted first) as binary
-/// silhouettes of the canonical body drawn as capsules, with the camera and
-/// the ground truth of every frame; with --color, also as color frames of
-/// the body in a room.
+/// silhouettes of the canonical body drawn as capsules (or of a test body,
+/// --body), with the camera and the ground truth of every frame; with
+/// --color, also as color frames of the body in a room.
 ///
 /// Writes DIR/frames/000000.png … (0 outside the body, 255 on it; noisy
-/// unless --noise none), DIR/camera.json and DIR/truth.csv, and with
-/// --color DIR/color/000000.png … and DIR/background.png (see docs/formats.md).
+/// unless --noise none), DIR/camera.json and DIR/truth.csv, with --color
+/// DIR/color/000000.png … and DIR/background.png, and with a test body
+/// DIR/body.toml (see docs/formats.md).
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The BVH file to render.
@@ -55,6 +57,12 @@ pub struct Args {
     /// 3). `light` is a good segmenter's output; `none` the clean render.
     #[arg(long, default_value = "light", value_name = "LEVEL")]
     pub noise: Level,
+    /// Who performs the take: `capsules` (the tracker's own body), a test
+    /// body built differently (`slight`, `lanky`, `average`, `skirt`,
+    /// `broad`, `heavy`), or a build file (.toml, see docs/formats.md).
+    /// truth.csv then holds that body's own joints.
+    #[arg(long, default_value = "capsules", value_name = "NAME|FILE.toml")]
+    pub body: String,
     /// Seed of the noise and of the room's textures; the same seed gives
     /// the same files.
     #[arg(long, default_value_t = 0)]
@@ -90,9 +98,17 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     }
     let (width, height) = parse_size(&args.size)?;
     let camera = camera(&args.camera, width, height)?;
+    let build = Build::choose(&args.body).map_err(|e| match e {
+        BuildError::Unknown(_) => UsageError(format!("--body: {e}")).into(),
+        e => anyhow::Error::from(e),
+    })?;
     refuse_nonempty(&args.output, args.force)?;
     let started = Instant::now();
     let (motion, labels) = take(&args.input, args.labels.as_deref(), &args.retarget, global)?;
+    let motion = match &build {
+        Some(build) => motion.on_body(&build.body()),
+        None => motion,
+    };
     let times: Vec<f64> = (0..).map(|k| k as f64 / args.fps).take_while(|&t| t <= motion.duration_s() + 1e-9).collect();
     let bar = progress(global, times.len() as u64, "render");
     let noise = Noise::new(args.noise, args.seed, &camera, times.len(), args.fps);
@@ -119,11 +135,21 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
                     |mask, (k, &t)| {
                         let pose = motion.pose_at(t);
                         let world = motion.body.forward(&pose);
-                        let parts = capsules(&motion.body, &world);
                         mask.clear();
-                        draw(&camera, &parts, mask);
+                        let surface: Box<dyn Surface> = match &build {
+                            Some(build) => {
+                                let figure = build.figure(&motion.body, &world);
+                                figure.draw(&camera, mask);
+                                Box::new(figure)
+                            }
+                            None => {
+                                let parts = capsules(&motion.body, &world);
+                                draw(&camera, &parts, mask);
+                                Box::new(parts)
+                            }
+                        };
                         if let Some(scene) = &scene {
-                            let rgb = scene.shade(k, &world, &parts, mask, &noise);
+                            let rgb = scene.shade(k, &world, surface.as_ref(), mask, &noise);
                             let encoded = encode(&rgb, width, height, image::ExtendedColorType::Rgb8);
                             std::fs::write(color.join(format!("{k:06}.png")), encoded)?;
                         }
@@ -138,6 +164,9 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
                 .collect::<std::io::Result<_>>()
                 .map_err(io)?;
             std::fs::write(dir.join("camera.json"), camera.to_json()).map_err(io)?;
+            if let Some(build) = &build {
+                std::fs::write(dir.join("body.toml"), build.to_toml()).map_err(io)?;
+            }
             write_atomic(&dir.join("truth.csv"), |w| {
                 w.write_all(truth::header().as_bytes())?;
                 rows.iter().try_for_each(|r| w.write_all(r.as_bytes()))
@@ -152,10 +181,11 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     note(
         global,
         &format!(
-            "{}: {} frames at {} Hz, {width}×{height}, noise {}{} → {output} in {seconds:.2} s ({:.0} frames/s)",
+            "{}: {} frames at {} Hz, {width}×{height}, {}, noise {}{} → {output} in {seconds:.2} s ({:.0} frames/s)",
             args.input.display(),
             times.len(),
             args.fps,
+            build.as_ref().map_or("the tracker's capsules".to_string(), |b| format!("body `{}`", b.name)),
             args.noise.name(),
             if args.color { ", color" } else { "" },
             times.len() as f64 / seconds

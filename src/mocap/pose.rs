@@ -151,6 +151,16 @@ impl Motion {
         let i = (at.floor() as usize).min(last);
         if i == last { self.poses[last] } else { self.poses[i].interpolate(&self.poses[i + 1], at - i as f64) }
     }
+
+    /// The same motion performed by `body`: every joint angle kept, the
+    /// root's path scaled by the ratio of pelvis heights, so the feet stay
+    /// on the ground and strides lengthen with the legs.
+    pub fn on_body(&self, body: &Body) -> Motion {
+        let scale = body.pelvis_height() / self.body.pelvis_height();
+        let poses = self.poses.iter().map(|p| Pose { root: p.root * scale, ..*p }).collect();
+        Motion { body: body.clone(), frame_time_s: self.frame_time_s, poses }
+    }
+
     /// The BVH skeleton of `body`: 6 channels on the pelvis, three rotation
     /// channels on every other joint (hinges too, for importers that expect
     /// three), end sites on the head, hands and feet.
@@ -286,5 +296,22 @@ mod tests {
         // At a frame's own time: that frame (up to conversion round-off).
         let at = m.pose_at(0.1);
         assert!(at.x.iter().zip(&b.x).all(|(p, q)| (p - q).abs() < 1e-12) && at.root == b.root);
+    }
+
+    #[test]
+    fn another_body_keeps_every_angle_and_stands_on_the_ground() {
+        use crate::mocap::body::Proportions;
+        let standard = Body::standard();
+        let mut step = Pose::rest(&standard);
+        step.root += DVec3::new(0.4, -0.05, 1.0);
+        step.x[Joint::LeftKnee.dof_offset()] = 0.7;
+        let short = Body::new(Proportions { height_m: 1.5, arm_scale: 1.0, leg_scale: 0.9 });
+        let moved = motion(vec![Pose::rest(&standard), step]).on_body(&short);
+        assert_eq!(moved.body, short);
+        assert_eq!(moved.poses[1].x, step.x);
+        // Standing at rest, the short body stands as it does at rest.
+        assert!((moved.poses[0].root - Pose::rest(&short).root).length() < 1e-12);
+        let scale = short.pelvis_height() / standard.pelvis_height();
+        assert!((moved.poses[1].root.z - scale).abs() < 1e-12);
     }
 }

@@ -20,10 +20,10 @@ use rand_chacha::ChaCha8Rng;
 
 /// Albedos, 8-bit RGB. The body's colors differ from the room's in hue, so
 /// a body part in shade is not taken for a shadow on the floor or wall.
-const SKIN: [f64; 3] = [235.0, 170.0, 135.0];
-const SHIRT: [f64; 3] = [195.0, 50.0, 55.0];
-const TROUSERS: [f64; 3] = [45.0, 65.0, 140.0];
-const SHOES: [f64; 3] = [150.0, 60.0, 40.0];
+pub const SKIN: [f64; 3] = [235.0, 170.0, 135.0];
+pub const SHIRT: [f64; 3] = [195.0, 50.0, 55.0];
+pub const TROUSERS: [f64; 3] = [45.0, 65.0, 140.0];
+pub const SHOES: [f64; 3] = [150.0, 60.0, 40.0];
 const FLOOR: [f64; 3] = [115.0, 160.0, 150.0];
 const WALL: [f64; 3] = [170.0, 190.0, 215.0];
 /// What a ray that meets neither floor nor wall sees (a dim ceiling).
@@ -119,6 +119,20 @@ fn closest(origin: DVec3, dir: DVec3, capsule: &Capsule) -> (DVec3, DVec3) {
     // Clamping either parameter moves the other's best value: project back.
     let s = if ee > 0.0 { ((on_ray - capsule.a).dot(e) / ee).clamp(0.0, 1.0) } else { 0.0 };
     (on_ray, capsule.a + s * e)
+}
+
+/// A body as the camera sees it in colour.
+pub trait Surface {
+    /// The albedo and outward normal where the ray from `origin` along
+    /// `dir` (through a pixel the body's mask covers) meets the body.
+    fn look(&self, origin: DVec3, dir: DVec3) -> ([f64; 3], DVec3);
+}
+
+impl Surface for [Capsule; CAPSULES] {
+    fn look(&self, origin: DVec3, dir: DVec3) -> ([f64; 3], DVec3) {
+        let (part, normal) = surface(origin, dir, self);
+        (PART_COLORS[part], normal)
+    }
 }
 
 /// The part a body pixel's ray shows and the surface normal there: the
@@ -299,20 +313,13 @@ impl Scene {
     }
 
     /// Frame `frame` in 8-bit RGB: the room, the shadow at the feet of
-    /// `world` darkening the floor, the body's `capsules` shaded over the
+    /// `world` darkening the floor, the body's `surface` shaded over the
     /// pixels of its clean silhouette `body`, the box passing in front, and
     /// the sensor's noise, as `noise` has them.
     ///
     /// # Panics
     /// If `body` is not the camera's frame size.
-    pub fn shade(
-        &self,
-        frame: usize,
-        world: &BodyFrame,
-        capsules: &[Capsule; CAPSULES],
-        body: &Mask,
-        noise: &Noise,
-    ) -> Vec<u8> {
+    pub fn shade(&self, frame: usize, world: &BodyFrame, surface: &dyn Surface, body: &Mask, noise: &Noise) -> Vec<u8> {
         let width = self.camera.width();
         assert_eq!((body.width(), body.height()), (width, self.camera.height()), "a mask the camera's size");
         let mut rgb = self.background.clone();
@@ -328,9 +335,9 @@ impl Scene {
         let origin = self.camera.position();
         for (k, _) in body.pixels().iter().enumerate().filter(|(_, p)| **p != 0) {
             let (i, j) = (k % width, k / width);
-            let (part, normal) = surface(origin, self.camera.ray(i as f64 + 0.5, j as f64 + 0.5), capsules);
+            let (albedo, normal) = surface.look(origin, self.camera.ray(i as f64 + 0.5, j as f64 + 0.5));
             let lit = AMBIENT + DIFFUSE * normal.dot(self.light).max(0.0);
-            rgb[3 * k..3 * k + 3].copy_from_slice(&PART_COLORS[part].map(|c| byte(c * lit)));
+            rgb[3 * k..3 * k + 3].copy_from_slice(&albedo.map(|c| byte(c * lit)));
         }
         if let Some(r) = noise.occluder(frame, world) {
             // A box lit from above: lighter at the top, a darker outline.

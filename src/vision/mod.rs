@@ -4,6 +4,7 @@
 pub mod camera;
 pub mod color;
 pub mod distance;
+pub mod figure;
 pub mod frames;
 pub mod mask;
 pub mod noise;
