@@ -9,6 +9,7 @@
 //!     cargo bench --bench track
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use imitate::track::calibrate::CalibrationParams;
 use imitate::track::filter::FilterParams;
 use imitate::track::tracker::{Recognition, TrackParams, Tracker};
 use imitate::vision::camera::{Camera, Preset};
@@ -38,9 +39,12 @@ fn track(c: &mut Criterion) {
     let frames = silhouettes(&camera);
     let mut group = c.benchmark_group("track_frame");
     for particles in [6, 50, 200] {
-        // The settings `imitate track --feedback` uses.
+        // The settings `imitate track --feedback` uses, calibration included
+        // (its fits, the first after 2 s and one every 6 s, spread over the
+        // frames timed).
         let filter = FilterParams::standard(particles, 5, 1.0 / 15.0);
-        let params = TrackParams { filter, recognition: Recognition::FEEDBACK, seed: 1 };
+        let calibration = Some(CalibrationParams::standard(None));
+        let params = TrackParams { filter, recognition: Recognition::FEEDBACK, calibration, seed: 1 };
         let mut tracker = Tracker::new(&vocabulary, camera.clone(), params).expect("valid settings");
         let mut k = 0;
         group.bench_function(BenchmarkId::new("4_primitives", particles), |b| {

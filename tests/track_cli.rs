@@ -112,6 +112,42 @@ fn a_frame_without_a_silhouette_is_coasted_and_left_without_activity() {
     assert_eq!(summary_without_timing(&tmp.path().join("run"))["coasted_frames"], 1);
 }
 
+#[test]
+fn a_person_built_unlike_the_capsules_is_measured_and_followed_closer_than_by_the_canonical_body() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let take = shipped("mocap/wave-h.bvh");
+    let labels = shipped("mocap/labels.csv");
+    let render = ["render", take.to_str().unwrap(), "-o", "video", "--labels", labels.to_str().unwrap()];
+    ok(run(dir, &[&render[..], &["--body", "slight"]].concat(), "2"));
+    let vocab = shipped("vocab/default.vocab");
+    let track = ["track", "video/frames", "--vocab", vocab.to_str().unwrap(), "--particles", "12", "--feedback"];
+    ok(run(dir, &[&track[..], &["-o", "fitted"]].concat(), "2"));
+    ok(run(dir, &[&track[..], &["-o", "canonical", "--no-calibrate"]].concat(), "2"));
+    ok(run(dir, &[&track[..], &["-o", "told", "--height", "1.5"]].concat(), "2"));
+    let body = |run: &str| summary_without_timing(&dir.join(run))["body"].clone();
+    let fitted = body("fitted");
+    // The slight build stands 1.50 m; the canonical body 1.75 m.
+    assert_eq!(fitted["calibrated"], true, "{fitted}");
+    let height = fitted["height_m"].as_f64().unwrap();
+    assert!((height - 1.5).abs() < 0.06, "{fitted}");
+    assert!(fitted["girth"]["trunk"].as_f64().unwrap() < 1.0, "{fitted}");
+    assert!(fitted["evaluations"].as_u64().unwrap() > 0);
+    assert_eq!(body("canonical")["calibrated"], false);
+    assert!(body("canonical")["note"].as_str().unwrap().contains("calibration off"));
+    let told = body("told");
+    assert_eq!((told["height_m"].as_f64(), told["height_given"].as_bool()), (Some(1.5), Some(true)), "{told}");
+    let root_mm = |run: &str| {
+        let estimate = imitate::report::read_track(&dir.join(run).join("frames.csv")).unwrap();
+        let truth = imitate::report::read_track(&dir.join("video/truth.csv")).unwrap();
+        let primitives = imitate::report::read_primitives(&dir.join(run).join("summary.json")).unwrap();
+        imitate::report::metrics::score(&estimate, &truth, &primitives, 0.5).unwrap().root_mm
+    };
+    // The canonical body stands far back to look as small as the person.
+    let (fitted, canonical) = (root_mm("fitted"), root_mm("canonical"));
+    assert!(fitted < 0.5 * canonical, "root {fitted:.0} mm calibrated, {canonical:.0} mm canonical");
+}
+
 /// A track that must fail: `code`, an error naming the problem, and no
 /// output folder.
 fn refused(dir: &Path, args: &[&str], code: i32, says: &str) {
@@ -133,6 +169,9 @@ fn bad_input_is_refused_with_nothing_written() {
     let vocab = vocab.to_str().unwrap();
     refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--particles", "0"], 2, "--particles 0");
     refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--lookahead", "0"], 2, "--lookahead 0");
+    refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--height", "0.5"], 2, "--height 0.5");
+    let both = ["track", frames, "--vocab", vocab, "-o", "out", "--height", "1.7", "--no-calibrate"];
+    refused(dir, &both, 2, "cannot be used with");
     refused(dir, &["track", frames, "--vocab", "missing.vocab", "-o", "out"], 1, "missing.vocab");
     refused(dir, &["track", "nowhere", "--vocab", vocab, "-o", "out"], 1, "nowhere");
     // Frames of another size than the camera's.
@@ -179,8 +218,10 @@ fn the_primitives_filters_halve_the_error_of_the_full_space_baseline_at_the_same
     let video = video(tmp.path());
     let vocab = shipped("vocab/default.vocab");
     let frames = video.join("frames");
+    // Neither draws anything but the canonical body: the budgets compared
+    // are the filters' alone.
     let track = ["track", frames.to_str().unwrap(), "--vocab", vocab.to_str().unwrap(), "--seed", "2"];
-    ok(run(tmp.path(), &[&track[..], &["-o", "primitives"]].concat(), "2"));
+    ok(run(tmp.path(), &[&track[..], &["-o", "primitives", "--no-calibrate"]].concat(), "2"));
     ok(run(tmp.path(), &[&track[..], &["-o", "baseline", "--baseline", "full-space"]].concat(), "2"));
 
     let per_frame =

@@ -559,7 +559,8 @@ fn baseline(work: &Work, plan: &Plan, front: &Video) -> anyhow::Result<Trial> {
         Variant {
             series: "primitives",
             params: serde_json::json!({"follower": "primitives"}),
-            options: &["--feedback"],
+            // Both draw the canonical body, so the budgets are the followers' alone.
+            options: &["--feedback", "--no-calibrate"],
         },
         Variant {
             series: "full-space annealed filter",
@@ -572,7 +573,7 @@ fn baseline(work: &Work, plan: &Plan, front: &Video) -> anyhow::Result<Trial> {
         title: "Baseline: full-space annealed particle filter".into(),
         about: "The trial-one sequence tracked by the primitives' filters and by one annealed particle filter over \
                 every joint angle and the root (Deutscher, Blake & Reid 2000) spending the same likelihood \
-                evaluations per frame."
+                evaluations per frame; neither calibrates the body."
             .into(),
         x_label: "particles per primitive (the budget)".into(),
         charts: vec![Measure::UpperBody],

@@ -10,6 +10,7 @@ use imitate::mocap::bvh::write_bvh;
 use imitate::mocap::pose::Motion;
 use imitate::mocap::pose::Pose;
 use imitate::track::baseline::{AnnealParams, FullSpaceFilter, mean_training_pose};
+use imitate::track::calibrate::{CalibrationParams, CalibrationReport, HEIGHT_M};
 use imitate::track::filter::FilterParams;
 use imitate::track::tracker::{FrameEstimate, Recognition, TrackParams, Tracker};
 use imitate::vision::camera::Camera;
@@ -65,6 +66,15 @@ pub struct Args {
     /// Frames per second of the input.
     #[arg(long, default_value_t = 15.0)]
     pub fps: f64,
+    /// The person's standing height in meters (1.0 to 2.3), when known:
+    /// calibration then fits only the limbs' shares and the girths.
+    #[arg(long, value_name = "M", conflicts_with = "baseline")]
+    pub height: Option<f64>,
+    /// Draw the canonical body throughout instead of fitting the person's
+    /// build (height, limb shares, girths) to the first seconds of
+    /// silhouettes.
+    #[arg(long, conflicts_with = "height")]
+    pub no_calibrate: bool,
     /// The empty scene, for color frames. Default: background.png beside
     /// the frames (as `render --color` writes it), else the per-pixel
     /// median of the frames.
@@ -118,6 +128,14 @@ impl Follower<'_> {
             Follower::FullSpace(filter) => filter.body(),
         }
     }
+
+    /// What calibration found (the baseline draws the canonical body).
+    fn calibration(&self) -> Option<&CalibrationReport> {
+        match self {
+            Follower::Primitives(tracker) => Some(tracker.calibration()),
+            Follower::FullSpace(_) => None,
+        }
+    }
 }
 
 fn params(args: &Args) -> Result<TrackParams, UsageError> {
@@ -130,9 +148,15 @@ fn params(args: &Args) -> Result<TrackParams, UsageError> {
     if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 1000.0) {
         return Err(UsageError(format!("--fps {}: must be above 0 and at most 1000", args.fps)));
     }
+    if let Some(h) = args.height
+        && !(h >= HEIGHT_M.0 && h <= HEIGHT_M.1)
+    {
+        return Err(UsageError(format!("--height {h}: a person's height is {} to {} m", HEIGHT_M.0, HEIGHT_M.1)));
+    }
     let recognition = if args.feedback { Recognition::FEEDBACK } else { Recognition::Likelihood };
     let filter = FilterParams::standard(args.particles, args.lookahead, 1.0 / args.fps);
-    Ok(TrackParams { filter, recognition, seed: args.seed })
+    let calibration = (!args.no_calibrate).then(|| CalibrationParams::standard(args.height));
+    Ok(TrackParams { filter, recognition, calibration, seed: args.seed })
 }
 
 fn choose_camera(args: &Args, source: &FrameSource) -> anyhow::Result<Camera> {
@@ -271,6 +295,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             "name": p.name(), "label": p.majority_label(), "dims": p.dims(),
         })).collect::<Vec<_>>(),
         "camera": camera.spec(),
+        "body": follower.calibration(),
         "background": silhouettes.background_used(),
         "settings": params,
         "baseline": args.baseline.map(|_| serde_json::json!({ "kind": "full_space", "settings": anneal })),

@@ -312,6 +312,31 @@ impl Body {
         Body { proportions: p, offsets, ends }
     }
 
+    /// The body that stands `standing_m` tall with arms and legs
+    /// `arm_share` and `leg_share` times the canonical body's shares of
+    /// its height (the trunk takes up the difference). Standing height is
+    /// linear in the legs' scale, s(L) = s₀ + b·L, and proportional to the
+    /// height scale, so both scales are solved directly.
+    pub fn of_shares(standing_m: f64, arm_share: f64, leg_share: f64) -> Body {
+        let unit = |leg_scale: f64| Body::new(Proportions { height_m: 1.0, arm_scale: 1.0, leg_scale });
+        let (s0, s1) = (unit(0.0).standing_height(), unit(1.0).standing_height());
+        // The leg scale L whose share L / s(L) is leg_share / s(1).
+        let share = leg_share / s1;
+        let leg_scale = share * s0 / (1.0 - share * (s1 - s0));
+        let stands = s0 + (s1 - s0) * leg_scale;
+        Body::new(Proportions { height_m: standing_m / stands, arm_scale: arm_share * stands / s1, leg_scale })
+    }
+
+    /// The arm and leg shares [`Body::of_shares`] built this body from.
+    pub fn shares(&self) -> (f64, f64) {
+        let canonical = Body::standard();
+        let share = |b: &Body, j: Joint| b.offset(j).length() / b.standing_height();
+        (
+            share(self, Joint::LeftWrist) / share(&canonical, Joint::LeftWrist),
+            share(self, Joint::LeftKnee) / share(&canonical, Joint::LeftKnee),
+        )
+    }
+
     /// Rest offset of `j` from its parent (for the pelvis: its rest
     /// position above the ground).
     pub fn offset(&self, j: Joint) -> DVec3 {
@@ -339,6 +364,11 @@ impl Body {
     /// Length of hip to knee to ankle, averaged over both legs.
     pub fn leg_length(&self) -> f64 {
         self.offset(Joint::LeftKnee).length() + self.offset(Joint::LeftAnkle).length()
+    }
+
+    /// Head top above the soles in the rest pose.
+    pub fn standing_height(&self) -> f64 {
+        self.pelvis_height() + self.trunk_length()
     }
 
     /// Length of the path pelvis → spine → chest → neck → head → head top.

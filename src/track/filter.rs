@@ -1,6 +1,7 @@
 //! One primitive's particle filter in its latent space (eq. 4).
 
 use crate::mocap::body::JointVector;
+use crate::track::calibrate::Physique;
 use crate::track::cone::{Cone, ConeScratch};
 use crate::track::root::{Root, RootSearch};
 use crate::vision::distance::Observation;
@@ -137,6 +138,11 @@ impl<'v> Filter<'v> {
 
     pub fn set_root(&mut self, root: Root) {
         self.root = root;
+    }
+
+    /// Draws hypotheses with this body from now on.
+    pub fn set_shape(&mut self, physique: &Physique) {
+        self.scorer.set_shape(physique.body.clone(), physique.girth);
     }
 
     pub fn evaluations(&self) -> u64 {

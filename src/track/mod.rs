@@ -3,10 +3,12 @@
 //! under the bending-cone motion model (eq. 6), each with its own global
 //! root; the estimates' likelihoods recognize the activity (eq. 7, or eq. 10
 //! with feedback), and the winner's pose each frame is the virtual
-//! trajectory. [`baseline`] is the full-space annealed filter the method
-//! is measured against.
+//! trajectory. [`calibrate`] fits the drawn body to the person;
+//! [`baseline`] is the full-space annealed filter the method is measured
+//! against.
 
 pub mod baseline;
+pub mod calibrate;
 pub mod cone;
 pub mod filter;
 pub mod root;

@@ -4,6 +4,7 @@
 
 use crate::mocap::body::Body;
 use crate::mocap::pose::Pose;
+use crate::track::calibrate::{self, CalibrationParams, CalibrationReport, Physique, Sample};
 use crate::track::filter::{Estimate, Filter, FilterParams};
 use crate::track::root::Root;
 use crate::vision::camera::Camera;
@@ -54,6 +55,9 @@ impl Recognition {
 pub struct TrackParams {
     pub filter: FilterParams,
     pub recognition: Recognition,
+    /// How the drawn body is fitted to the person; `None` keeps the
+    /// canonical body throughout.
+    pub calibration: Option<CalibrationParams>,
     pub seed: u64,
 }
 
@@ -86,8 +90,9 @@ pub struct FrameEstimate {
 pub struct Tracker<'v> {
     filters: Vec<Filter<'v>>,
     camera: Camera,
-    body: Body,
+    physique: Physique,
     params: TrackParams,
+    calibration: Calibrating,
     /// `w_i` of eq. 10.
     history: Vec<f64>,
     placed: bool,
@@ -106,7 +111,8 @@ impl<'v> Tracker<'v> {
         if primitives.is_empty() {
             return Err(TrackError::EmptyVocabulary);
         }
-        let body = Body::standard();
+        let physique = Physique::canonical();
+        let body = &physique.body;
         // Until a silhouette places it, the person stands where the camera looks.
         let look_at = DVec3::from_array(camera.spec().look_at);
         let root = Root { position: DVec3::new(look_at.x, body.pelvis_height(), look_at.z), heading: 0.0 };
@@ -120,16 +126,33 @@ impl<'v> Tracker<'v> {
             })
             .collect();
         let n = primitives.len();
-        Ok(Tracker { filters, camera, body, params, history: vec![1.0 / n as f64; n], placed: false, winner: 0 })
+        let calibration = Calibrating::new(params.calibration);
+        Ok(Tracker {
+            filters,
+            camera,
+            physique,
+            params,
+            calibration,
+            history: vec![1.0 / n as f64; n],
+            placed: false,
+            winner: 0,
+        })
     }
 
+    /// The skeleton drawn now (calibration changes it).
     pub fn body(&self) -> &Body {
-        &self.body
+        &self.physique.body
     }
 
-    /// Likelihood evaluations made so far, over every primitive.
+    /// What calibration has found so far.
+    pub fn calibration(&self) -> &CalibrationReport {
+        &self.calibration.report
+    }
+
+    /// Likelihood evaluations made so far, over every primitive and
+    /// calibration.
     pub fn evaluations(&self) -> u64 {
-        self.filters.iter().map(Filter::evaluations).sum()
+        self.filters.iter().map(Filter::evaluations).sum::<u64>() + self.calibration.report.evaluations
     }
 
     /// Tracks one frame's silhouette (the camera's size).
@@ -157,12 +180,99 @@ impl<'v> Tracker<'v> {
         }
         let chosen = &estimates[self.winner];
         let pose = chosen.root.pose(&chosen.x);
+        if let Some(observation) = observation
+            && self.placed
+        {
+            self.calibrate(silhouette, observation, pose);
+        }
         FrameEstimate { estimates, probabilities, winner: self.winner, pose }
+    }
+
+    /// Collects the frame for calibration and fits the body when a window
+    /// is full: the first fit from the canonical body, later ones a step
+    /// of the way from the current build towards their own.
+    fn calibrate(&mut self, silhouette: &Mask, observation: Observation, pose: Pose) {
+        let Some(params) = self.params.calibration else { return };
+        let dt = self.params.filter.frame_time_s;
+        let state = &mut self.calibration;
+        state.seen_s += dt;
+        let window = (params.window_s / dt).round().max(1.0) as usize;
+        if calibrate::whole(silhouette) {
+            state.samples.push(Sample { observation, pose });
+            if state.samples.len() > window {
+                state.samples.remove(0);
+            }
+        }
+        let first = !state.report.calibrated;
+        if first && state.report.note.is_some() {
+            return; // given up
+        }
+        let due = if first { params.window_s } else { params.refine_every_s };
+        if state.seen_s + 1e-9 < state.next_s + due {
+            if first && state.seen_s > params.give_up_s && state.samples.len() < params.min_frames {
+                state.report.note = Some(format!(
+                    "no standing frame to calibrate from: fewer than {} frames showed the whole person in the \
+                     first {} s; the canonical body was drawn throughout",
+                    params.min_frames, params.give_up_s
+                ));
+                state.samples.clear();
+            }
+            return;
+        }
+        // The window is over: fit if it had enough whole frames, else
+        // wait for more (the first fit) or for the next window.
+        if state.samples.len() < params.min_frames {
+            if !first {
+                state.next_s = state.seen_s;
+            }
+            return;
+        }
+        let start = self.physique.clone();
+        let samples = std::mem::take(&mut state.samples);
+        state.next_s = state.seen_s;
+        let Some(fit) = calibrate::fit(&self.camera, &samples, &start, params.height_m, !first) else { return };
+        let report = &mut state.report;
+        report.evaluations += fit.evaluations;
+        if first {
+            report.calibrated = true;
+            report.frames = fit.frames;
+            report.height_se_m = fit.height_se_m;
+            report.log_likelihood_gain = fit.log_likelihood_gain;
+            if !fit.accepted {
+                report.note = Some(format!(
+                    "the body drawn explains the person as well as any build fitted (mean log R gained {:.3} per \
+                     frame): kept",
+                    fit.log_likelihood_gain
+                ));
+            }
+        } else if fit.accepted {
+            report.refinements += 1;
+        }
+        if !fit.accepted {
+            return;
+        }
+        let physique = if first { fit.physique.clone() } else { blend(&start, &fit.physique, params.refine_rate) };
+        report.height_m = physique.body.standing_height();
+        (report.arm_share, report.leg_share) = physique.body.shares();
+        report.girth = physique.girth;
+        // Every filter goes on from the winner's root moved for the new
+        // build, as the fit placed it.
+        let scale = physique.body.pelvis_height() / fit.physique.body.pelvis_height();
+        let root = Root {
+            position: glam::DVec3::new(fit.last_pose.root.x, fit.last_pose.root.y * scale, fit.last_pose.root.z),
+            heading: fit.last_pose.heading,
+        };
+        for f in &mut self.filters {
+            f.set_shape(&physique);
+            f.set_root(root);
+        }
+        self.physique = physique;
     }
 
     /// Puts every filter's root on the person the first time one shows.
     fn place(&mut self, silhouette: &Mask, observation: &Observation) {
-        let Some(root) = Root::from_silhouette(&self.camera, silhouette, self.body.pelvis_height(), 0.0) else {
+        let Some(root) = Root::from_silhouette(&self.camera, silhouette, self.physique.body.pelvis_height(), 0.0)
+        else {
             return;
         };
         // A silhouette looks the same from the front as from the back, so
@@ -211,6 +321,46 @@ impl<'v> Tracker<'v> {
     }
 }
 
+/// Calibration's state: frames collected and what was found.
+struct Calibrating {
+    samples: Vec<Sample>,
+    /// Seconds of observed frames since the person was placed, and when
+    /// the current window began.
+    seen_s: f64,
+    next_s: f64,
+    report: CalibrationReport,
+}
+
+impl Calibrating {
+    fn new(params: Option<CalibrationParams>) -> Calibrating {
+        let mut report = CalibrationReport::canonical(params.and_then(|p| p.height_m));
+        if params.is_none() {
+            report.note = Some("calibration off: the canonical body was drawn throughout".into());
+        }
+        Calibrating { samples: Vec::new(), seen_s: 0.0, next_s: 0.0, report }
+    }
+}
+
+/// A build `rate` of the way from `from` to `to`.
+fn blend(from: &Physique, to: &Physique, rate: f64) -> Physique {
+    let mix = |a: f64, b: f64| a + rate * (b - a);
+    let (p, q) = (from.body.shares(), to.body.shares());
+    let (g, h) = (&from.girth, &to.girth);
+    Physique {
+        body: Body::of_shares(
+            mix(from.body.standing_height(), to.body.standing_height()),
+            mix(p.0, q.0),
+            mix(p.1, q.1),
+        ),
+        girth: crate::vision::shape::Girth {
+            head: mix(g.head, h.head),
+            trunk: mix(g.trunk, h.trunk),
+            arms: mix(g.arms, h.arms),
+            legs: mix(g.legs, h.legs),
+        },
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -234,7 +384,7 @@ mod tests {
             frame_time_s: 0.1,
         };
         let camera = Camera::preset(Preset::Front, 40, 30).unwrap();
-        Tracker::new(vocabulary, camera, TrackParams { filter, recognition, seed: 1 }).unwrap()
+        Tracker::new(vocabulary, camera, TrackParams { filter, recognition, calibration: None, seed: 1 }).unwrap()
     }
 
     /// Estimates whose likelihoods and evidence are `r` times a common factor.

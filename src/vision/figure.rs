@@ -11,8 +11,8 @@
 //! by pixel, so they are exact and slow beside the tracker's renderer;
 //! they only draw test videos.
 
-use crate::mocap::body::{Body, Joint, Proportions};
-use crate::mocap::pose::{BodyFrame, Pose};
+use crate::mocap::body::{Body, Joint};
+use crate::mocap::pose::BodyFrame;
 use crate::vision::camera::Camera;
 use crate::vision::color::{SHIRT, SHOES, SKIN, Surface, TROUSERS};
 use crate::vision::mask::Mask;
@@ -183,26 +183,13 @@ impl Build {
     /// `height_m` tall, its arms and legs the given multiples of the
     /// canonical body's shares of the height.
     pub fn body(&self) -> Body {
-        let unit = |leg_scale: f64| Body::new(Proportions { height_m: 1.0, arm_scale: 1.0, leg_scale });
-        // Standing height is linear in the legs' scale: s(L) = s₀ + b·L.
-        let (s0, s1) = (standing_height(&unit(0.0)), standing_height(&unit(1.0)));
-        // The leg scale whose share of the height, L / s(L), is
-        // leg_share times the canonical 1 / s(1).
-        let share = self.leg_share / s1;
-        let leg_scale = share * s0 / (1.0 - share * (s1 - s0));
-        let stands = s0 + (s1 - s0) * leg_scale;
-        Body::new(Proportions { height_m: self.height_m / stands, arm_scale: self.arm_share * stands / s1, leg_scale })
+        Body::of_shares(self.height_m, self.arm_share, self.leg_share)
     }
 
     /// The figure in a posed frame of [`Build::body`].
     pub fn figure(&self, body: &Body, frame: &BodyFrame) -> Figure {
         Figure { parts: parts(self, body, frame) }
     }
-}
-
-/// Head top above the soles in the rest pose.
-pub fn standing_height(body: &Body) -> f64 {
-    body.forward(&Pose::rest(body)).bone_end(body, Joint::Head).y
 }
 
 /// A solid of a figure, in world meters.
@@ -511,6 +498,7 @@ fn parts(build: &Build, body: &Body, frame: &BodyFrame) -> Vec<Part> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mocap::pose::Pose;
     use crate::vision::camera::Preset;
     use crate::vision::render::draw;
     use crate::vision::shape::capsules;
@@ -572,15 +560,11 @@ mod tests {
 
     #[test]
     fn each_build_stands_its_height_with_its_limb_shares() {
-        let standard = Body::standard();
         for build in Build::presets() {
             let body = build.body();
-            assert!((standing_height(&body) - build.height_m).abs() < 1e-9, "{}", build.name);
-            let share = |b: &Body, j: Joint| b.offset(j).length() / standing_height(b);
-            for (j, s) in [(Joint::LeftWrist, build.arm_share), (Joint::LeftKnee, build.leg_share)] {
-                let ratio = share(&body, j) / share(&standard, j);
-                assert!((ratio - s).abs() < 1e-9, "{}: {j:?} {ratio}", build.name);
-            }
+            assert!((body.standing_height() - build.height_m).abs() < 1e-9, "{}", build.name);
+            let (arms, legs) = body.shares();
+            assert!((arms - build.arm_share).abs() < 1e-9 && (legs - build.leg_share).abs() < 1e-9, "{}", build.name);
         }
     }
 

@@ -7,7 +7,7 @@ use crate::vision::camera::Camera;
 use crate::vision::distance::{Observation, Scratch};
 use crate::vision::mask::Mask;
 use crate::vision::render::draw;
-use crate::vision::shape::capsules;
+use crate::vision::shape::{Girth, shaped_capsules};
 
 /// Draws hypotheses of one body through one camera and scores them against
 /// observations. It owns every buffer it works in, so scoring allocates
@@ -16,6 +16,7 @@ use crate::vision::shape::capsules;
 pub struct Scorer {
     camera: Camera,
     body: Body,
+    girth: Girth,
     drawn: Mask,
     scratch: Scratch,
 }
@@ -23,7 +24,16 @@ pub struct Scorer {
 impl Scorer {
     pub fn new(camera: Camera, body: Body) -> Scorer {
         let drawn = Mask::new(camera.width(), camera.height());
-        Scorer { camera, body, drawn, scratch: Scratch::default() }
+        Scorer { camera, body, girth: Girth::CANONICAL, drawn, scratch: Scratch::default() }
+    }
+
+    /// Draws from now on a body of this skeleton and girth.
+    pub fn set_shape(&mut self, body: Body, girth: Girth) {
+        (self.body, self.girth) = (body, girth);
+    }
+
+    pub fn girth(&self) -> &Girth {
+        &self.girth
     }
 
     pub fn camera(&self) -> &Camera {
@@ -37,7 +47,7 @@ impl Scorer {
     /// The silhouette of `pose` as this camera sees the body.
     pub fn draw(&mut self, pose: &Pose) -> &Mask {
         self.drawn.clear();
-        draw(&self.camera, &capsules(&self.body, &self.body.forward(pose)), &mut self.drawn);
+        draw(&self.camera, &shaped_capsules(&self.body, &self.girth, &self.body.forward(pose)), &mut self.drawn);
         &self.drawn
     }
 

@@ -66,22 +66,59 @@ pub fn bone_radius_share(j: Joint) -> f64 {
     PARTS.iter().find(|(span, _)| along(span)).map_or(trunk, |part| part.1)
 }
 
-/// The body's capsules in a posed frame.
+/// How thick the drawn body's parts are: multiples of the canonical radii
+/// for each group of capsules. A person's build is estimated as this and
+/// the skeleton's proportions; poses stay in the canonical joint space.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Girth {
+    /// Head and neck.
+    pub head: f64,
+    /// The trunk's three capsules.
+    pub trunk: f64,
+    /// Upper arms, forearms and hands.
+    pub arms: f64,
+    /// Thighs, shins and feet.
+    pub legs: f64,
+}
+
+impl Girth {
+    pub const CANONICAL: Girth = Girth { head: 1.0, trunk: 1.0, arms: 1.0, legs: 1.0 };
+
+    /// The multiple for capsule `k` of [`PARTS`]' order.
+    fn of(&self, k: usize) -> f64 {
+        match k {
+            0 | 1 => self.head,
+            4..=9 => self.arms,
+            10..=15 => self.legs,
+            _ => self.trunk,
+        }
+    }
+}
+
+/// The body's capsules in a posed frame, at the canonical girth.
 pub fn capsules(body: &Body, frame: &BodyFrame) -> [Capsule; CAPSULES] {
+    shaped_capsules(body, &Girth::CANONICAL, frame)
+}
+
+/// The body's capsules in a posed frame, each group as thick as `girth`
+/// says.
+pub fn shaped_capsules(body: &Body, girth: &Girth, frame: &BodyFrame) -> [Capsule; CAPSULES] {
     let height = body.proportions.height_m;
-    let place = |(span, share): (Span, f64)| {
+    let mut k = 0;
+    PARTS.map(|(span, share)| {
+        let radius = share * height * girth.of(k);
+        k += 1;
         let (a, b) = match span {
             Span::Joints(from, to) => (frame.position(from), frame.position(to)),
             // The rounded end reaches the end site (head top, finger or
             // toe tip) rather than passing it by a radius.
             Span::Bone(j) => {
                 let (a, end) = (frame.position(j), frame.bone_end(body, j));
-                (a, end - (end - a).normalize_or_zero() * (share * height).min((end - a).length()))
+                (a, end - (end - a).normalize_or_zero() * radius.min((end - a).length()))
             }
         };
-        Capsule { a, b, radius: share * height }
-    };
-    PARTS.map(place)
+        Capsule { a, b, radius }
+    })
 }
 
 #[cfg(test)]
