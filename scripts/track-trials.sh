@@ -11,7 +11,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --quiet
-imitate="$PWD/target/release/imitate"
+imitate="${CARGO_TARGET_DIR:-$PWD/target}/release/imitate"
 real="${IMITATE_REAL_MOCAP:-$PWD/../shared/mocap/real}"
 work="${1:-$(mktemp -d)}"
 mkdir -p "$work"

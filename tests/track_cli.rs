@@ -148,6 +148,44 @@ fn a_person_built_unlike_the_capsules_is_measured_and_followed_closer_than_by_th
     assert!(fitted < 0.5 * canonical, "root {fitted:.0} mm calibrated, {canonical:.0} mm canonical");
 }
 
+#[test]
+fn the_frame_rate_is_the_input_s_own_unless_told() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let take = shipped("mocap/wave-h.bvh");
+    ok(run(dir, &["render", take.to_str().unwrap(), "-o", "video", "--fps", "30"], "2"));
+    let vocab = shipped("vocab/default.vocab");
+    let vocab = vocab.to_str().unwrap();
+    let rate = |run: &str| {
+        let summary = summary_without_timing(&dir.join(run));
+        (summary["fps"].as_f64().unwrap(), summary["fps_from"].as_str().unwrap().to_string())
+    };
+    // A rendered folder: the rate of its truth.csv, and the rows' times are the truth's.
+    ok(run(dir, &["track", "video/frames", "--vocab", vocab, "-o", "folder"], "2"));
+    assert_eq!(rate("folder"), (30.0, "truth".into()));
+    let times = |path: &str| -> Vec<String> {
+        let text = fs::read_to_string(dir.join(path)).unwrap();
+        text.lines().skip(1).map(|l| l.split(',').nth(1).unwrap().to_string()).collect()
+    };
+    assert_eq!(times("folder/frames.csv"), times("video/truth.csv"));
+    ok(run(dir, &["track", "video/frames", "--vocab", vocab, "-o", "told", "--fps", "12.5"], "2"));
+    assert_eq!(rate("told"), (12.5, "option".into()));
+    // A video: the rate its container states.
+    let ffmpeg = std::process::Command::new("ffmpeg").arg("-version").output().is_ok_and(|o| o.status.success());
+    assert!(ffmpeg || std::env::var_os("CI").is_none(), "ffmpeg is not on PATH: under CI it is required");
+    if ffmpeg {
+        let made = std::process::Command::new("ffmpeg")
+            .args(["-v", "error", "-framerate", "25", "-i", "video/frames/%06d.png", "-c:v", "ffv1", "clip.mkv"])
+            .current_dir(dir)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let args = ["track", "clip.mkv", "--vocab", vocab, "-o", "clip", "--camera", "video/camera.json"];
+        ok(run(dir, &args, "2"));
+        assert_eq!(rate("clip"), (25.0, "video".into()));
+    }
+}
+
 /// A track that must fail: `code`, an error naming the problem, and no
 /// output folder.
 fn refused(dir: &Path, args: &[&str], code: i32, says: &str) {
@@ -170,6 +208,7 @@ fn bad_input_is_refused_with_nothing_written() {
     refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--particles", "0"], 2, "--particles 0");
     refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--lookahead", "0"], 2, "--lookahead 0");
     refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--height", "0.5"], 2, "--height 0.5");
+    refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--fps", "0"], 2, "--fps 0");
     let both = ["track", frames, "--vocab", vocab, "-o", "out", "--height", "1.7", "--no-calibrate"];
     refused(dir, &both, 2, "cannot be used with");
     refused(dir, &["track", frames, "--vocab", "missing.vocab", "-o", "out"], 1, "missing.vocab");

@@ -14,7 +14,7 @@ use imitate::track::calibrate::{CalibrationParams, CalibrationReport, HEIGHT_M};
 use imitate::track::filter::FilterParams;
 use imitate::track::tracker::{FrameEstimate, Recognition, TrackParams, Tracker};
 use imitate::vision::camera::Camera;
-use imitate::vision::frames::{Expect, FrameSource, beside_frames};
+use imitate::vision::frames::{Expect, FrameSource, beside_frames, video_frame_rate};
 use imitate::vision::mask::Mask;
 use imitate::vision::silhouette::Silhouettes;
 use imitate::vision::truth;
@@ -63,9 +63,10 @@ pub struct Args {
     /// probability, instead of eq. 7's likelihoods alone.
     #[arg(long)]
     pub feedback: bool,
-    /// Frames per second of the input.
-    #[arg(long, default_value_t = 15.0)]
-    pub fps: f64,
+    /// Frames per second of the input. Default: a video's own rate; for
+    /// a folder, the rate of the truth.csv `render` wrote beside it, else 15.
+    #[arg(long)]
+    pub fps: Option<f64>,
     /// The person's standing height in meters (1.0 to 2.3), when known:
     /// calibration then fits only the limbs' shares and the girths.
     #[arg(long, value_name = "M", conflicts_with = "baseline")]
@@ -138,15 +139,17 @@ impl Follower<'_> {
     }
 }
 
-fn params(args: &Args) -> Result<TrackParams, UsageError> {
+fn params(args: &Args, fps: f64) -> Result<TrackParams, UsageError> {
     if args.particles == 0 {
         return Err(UsageError("--particles 0: a filter needs at least 1 particle".into()));
     }
     if args.lookahead == 0 {
         return Err(UsageError("--lookahead 0: the bending cone needs at least 1 prediction".into()));
     }
-    if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 1000.0) {
-        return Err(UsageError(format!("--fps {}: must be above 0 and at most 1000", args.fps)));
+    if let Some(fps) = args.fps
+        && !(fps.is_finite() && fps > 0.0 && fps <= 1000.0)
+    {
+        return Err(UsageError(format!("--fps {fps}: must be above 0 and at most 1000")));
     }
     if let Some(h) = args.height
         && !(h >= HEIGHT_M.0 && h <= HEIGHT_M.1)
@@ -154,7 +157,7 @@ fn params(args: &Args) -> Result<TrackParams, UsageError> {
         return Err(UsageError(format!("--height {h}: a person's height is {} to {} m", HEIGHT_M.0, HEIGHT_M.1)));
     }
     let recognition = if args.feedback { Recognition::FEEDBACK } else { Recognition::Likelihood };
-    let filter = FilterParams::standard(args.particles, args.lookahead, 1.0 / args.fps);
+    let filter = FilterParams::standard(args.particles, args.lookahead, 1.0 / fps);
     let calibration = (!args.no_calibrate).then(|| CalibrationParams::standard(args.height));
     Ok(TrackParams { filter, recognition, calibration, seed: args.seed })
 }
@@ -243,11 +246,54 @@ fn row(
     line
 }
 
+/// Where the frame rate came from.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+enum RateFrom {
+    Option,
+    Video,
+    Truth,
+    Default,
+}
+
+/// The frames' rate: `--fps`, else a video's own, else (a folder) the
+/// rate of the truth.csv `render` wrote beside it, else 15 (the paper's
+/// camera).
+fn frame_rate(args: &Args, source: &FrameSource) -> anyhow::Result<(f64, RateFrom)> {
+    if let Some(fps) = args.fps {
+        return Ok((fps, RateFrom::Option));
+    }
+    if source.is_video() {
+        return match video_frame_rate(&args.input)? {
+            Some(fps) if fps <= 1000.0 => Ok((fps, RateFrom::Video)),
+            Some(fps) => Err(UsageError(format!(
+                "{}: the video states {fps} frames a second, more than 1000; pass --fps",
+                args.input.display()
+            ))
+            .into()),
+            None => {
+                Err(UsageError(format!("{}: the video states no frame rate; pass --fps", args.input.display())).into())
+            }
+        };
+    }
+    if let Some(truth) = beside_frames(&args.input, "truth.csv")
+        && let Some(fps) = truth::frame_rate(&truth)?
+    {
+        return Ok((fps, RateFrom::Truth));
+    }
+    Ok((DEFAULT_FPS, RateFrom::Default))
+}
+
+/// A folder's frame rate when nothing says otherwise: the paper's camera's.
+const DEFAULT_FPS: f64 = 15.0;
+
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
-    let params = params(&args)?;
+    params(&args, DEFAULT_FPS)?;
     refuse_nonempty(&args.output, args.force)?;
     let vocabulary = Vocabulary::load(&args.vocab)?;
     let source = FrameSource::open(&args.input, Expect::Auto)?;
+    let (fps, rate_from) = frame_rate(&args, &source)?;
+    let params = params(&args, fps)?;
     let camera = choose_camera(&args, &source)?;
     let tracker =
         Tracker::new(&vocabulary, camera.clone(), params).with_context(|| args.vocab.display().to_string())?;
@@ -270,7 +316,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         silhouette?;
         let (pose, estimate) = follower.step(&mask);
         coasted += usize::from(mask.count() == 0);
-        rows.push(row(k, k as f64 / args.fps, &names, &pose, estimate.as_ref(), follower.body()));
+        rows.push(row(k, k as f64 / fps, &names, &pose, estimate.as_ref(), follower.body()));
         if let Some(e) = &estimate {
             likelihood_rows.push(likelihood_row(k, e));
         }
@@ -284,7 +330,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     }
     let seconds = started.elapsed().as_secs_f64();
     let evaluations = follower.evaluations();
-    let motion = Motion { body: follower.body().clone(), frame_time_s: 1.0 / args.fps, poses };
+    let motion = Motion { body: follower.body().clone(), frame_time_s: 1.0 / fps, poses };
     let summary = serde_json::json!({
         "input": args.input.display().to_string(),
         "vocabulary": {
@@ -300,7 +346,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         "settings": params,
         "baseline": args.baseline.map(|_| serde_json::json!({ "kind": "full_space", "settings": anneal })),
         "seed": args.seed,
-        "fps": args.fps,
+        "fps": fps,
+        "fps_from": rate_from,
         "frames": k,
         "coasted_frames": coasted,
         "likelihood_evaluations": evaluations,

@@ -1,4 +1,4 @@
-//! Retargeting by bone direction (GUIDE §2): forward kinematics on the
+//! Retargeting by bone direction (docs/method.md, "Retargeting"): forward kinematics on the
 //! source skeleton, then for every canonical joint the rotation that points
 //! its bone where the source bone points, with the twist about the bone
 //! taken from a second direction:

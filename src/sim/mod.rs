@@ -1,4 +1,4 @@
-//! The simulated humanoid (GUIDE §4.6): the canonical body as rigid bodies
+//! The simulated humanoid: the canonical body as rigid bodies
 //! in rapier3d, with anthropometric masses and a motor on every joint, and
 //! the playing of a trajectory on it (`imitate execute`).
 

@@ -10,6 +10,10 @@ use crate::vocab::primitive::Primitive;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
+/// The frame rate [`FilterParams::standard`] was tuned at (the paper's
+/// camera's).
+const TUNED_FPS: f64 = 15.0;
+
 /// Settings every primitive's filter shares.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct FilterParams {
@@ -37,9 +41,15 @@ pub struct FilterParams {
 
 impl FilterParams {
     /// The settings `imitate track` uses, tuned on the documented
-    /// three-activity sequence: noise across the cone half a frame's typical
-    /// step, R^8, a manifold prior two steps wide, 5% renewal, and 4 root
-    /// steps of 3 cm and 0.005 rad a frame.
+    /// three-activity sequence at 15 frames a second: noise across the cone
+    /// half a frame's typical step, R^8, a manifold prior two steps wide, 5%
+    /// renewal, and 4 root steps of 3 cm and 0.005 rad a frame.
+    ///
+    /// At other frame rates they keep what they do in a second: the cone's
+    /// step is the primitive's speed times the frame time already; renewal
+    /// keeps 0.95 of the particles per fifteenth of a second, and the root's
+    /// random walk spreads as far in a second (steps scaled by the square
+    /// root of the frame time).
     ///
     /// The turn is small on purpose. A silhouette hardly shows a few
     /// degrees of heading, and a turned torso can make up for a wrong arm
@@ -48,15 +58,26 @@ impl FilterParams {
     /// degrees a second) are still followed, and placement tries every
     /// heading.
     pub fn standard(particles: usize, lookahead: usize, frame_time_s: f64) -> FilterParams {
+        let fifteenths = frame_time_s * TUNED_FPS;
         FilterParams {
             particles,
             cone: Cone { lookahead, spread: 0.5 },
             sharpness: 8.0,
             manifold: 2.0,
-            renewal: 0.05,
-            root: RootSearch { steps: 4, move_m: 0.03, turn_rad: 0.005 },
+            renewal: 1.0 - 0.95f64.powf(fifteenths),
+            root: RootSearch { steps: 4, move_m: 0.03 * fifteenths.sqrt(), turn_rad: 0.005 * fifteenths.sqrt() },
             frame_time_s,
         }
+    }
+
+    /// The power recognition raises each primitive's evidence to: the
+    /// sharpness at the rate it was tuned at, scaled with the frame time,
+    /// so that a second of frames weighs as much at any rate (frames closer
+    /// together are not independent evidence: at 60 frames a second the
+    /// unscaled power made eq. 10 four times as sure a second and
+    /// recognition fell from 98% to 87%).
+    pub fn evidence_power(&self) -> f64 {
+        self.sharpness * self.frame_time_s * TUNED_FPS
     }
 
     /// Likelihood evaluations a frame costs after the first: every
@@ -290,4 +311,26 @@ pub fn systematic<'w>(weights: &'w [f64], rng: &mut impl Rng) -> impl Iterator<I
         }
         j
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_second_of_frames_renews_moves_and_weighs_alike_at_any_rate() {
+        let at = |fps: f64| FilterParams::standard(25, 5, 1.0 / fps);
+        let tuned = at(TUNED_FPS);
+        assert_eq!((tuned.renewal, tuned.root.move_m, tuned.evidence_power()), (1.0 - 0.95, 0.03, 8.0));
+        for fps in [25.0, 29.97, 60.0] {
+            let p = at(fps);
+            // Particles kept unrenewed over a second, the root walk's spread
+            // over a second, and the evidence's power summed over a second.
+            let kept = (1.0 - p.renewal).powf(fps);
+            assert!((kept - 0.95f64.powf(TUNED_FPS)).abs() < 1e-12, "{fps}");
+            let spread = p.root.move_m * fps.sqrt();
+            assert!((spread - 0.03 * TUNED_FPS.sqrt()).abs() < 1e-12, "{fps}");
+            assert!((p.evidence_power() * fps - 8.0 * TUNED_FPS).abs() < 1e-9, "{fps}");
+        }
+    }
 }

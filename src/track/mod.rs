@@ -1,4 +1,4 @@
-//! Tracking (GUIDE §4): from silhouettes and a vocabulary, one particle
+//! Tracking: from silhouettes and a vocabulary, one particle
 //! filter per primitive infers pose in that primitive's latent space (eq. 4)
 //! under the bending-cone motion model (eq. 6), each with its own global
 //! root; the estimates' likelihoods recognize the activity (eq. 7, or eq. 10

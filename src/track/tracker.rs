@@ -26,7 +26,8 @@ const PLACEMENT_STEPS: usize = 40;
 
 /// How the primitives' estimates become activity probabilities. Both weigh
 /// each primitive by its [`Estimate::evidence`] to the filters' sharpness
-/// (`R^sharpness`, eq. 8 sharpened, see [`FilterParams::sharpness`]): the
+/// (`R^sharpness`, eq. 8 sharpened, see [`FilterParams::sharpness`], per
+/// fifteenth of a second: [`FilterParams::evidence_power`]): the
 /// estimate's fit together with how well the primitive's dynamics
 /// predicted the frame. The estimate's R alone let a primitive win by
 /// jumping to whatever pose of its span fits (from the side, hand circles
@@ -298,7 +299,7 @@ impl<'v> Tracker<'v> {
         // Relative to the best, so the power cannot underflow all.
         let top = estimates.iter().map(evidence).fold(f64::MIN, f64::max);
         let mut p: Vec<f64> =
-            estimates.iter().map(|e| (evidence(e) / top).powf(self.params.filter.sharpness)).collect();
+            estimates.iter().map(|e| (evidence(e) / top).powf(self.params.filter.evidence_power())).collect();
         if let Recognition::Feedback { .. } = self.params.recognition {
             self.forget();
             p.iter_mut().zip(&self.history).for_each(|(p, w)| *p *= w);
@@ -381,7 +382,8 @@ mod tests {
             manifold: 2.0,
             renewal: 0.0,
             root: RootSearch { steps: 0, move_m: 0.0, turn_rad: 0.0 },
-            frame_time_s: 0.1,
+            // The rate the sharpness is tuned at: the evidence's power is 4.
+            frame_time_s: 1.0 / 15.0,
         };
         let camera = Camera::preset(Preset::Front, 40, 30).unwrap();
         Tracker::new(vocabulary, camera, TrackParams { filter, recognition, calibration: None, seed: 1 }).unwrap()
@@ -448,8 +450,8 @@ mod tests {
         t.recognize(&e);
         let before = t.history[0];
         t.forget();
-        // One frame of 0.1 s keeps exp(−0.1/0.6) of the history and shares the rest evenly.
-        let keep = (-0.1f64 / 0.6).exp();
+        // One frame of 1/15 s keeps exp(−(1/15)/0.6) of the history and shares the rest evenly.
+        let keep = (-(1.0f64 / 15.0) / 0.6).exp();
         assert!((t.history[0] - (keep * before + (1.0 - keep) / n)).abs() < 1e-12);
         for _ in 0..200 {
             t.forget();

@@ -3,7 +3,7 @@
 //! points to pixels.
 //!
 //! World frame: meters, Y up, right-handed, the person facing +Z at heading
-//! 0 (GUIDE §6). Camera frame: X to the image's right, Y down the image, Z
+//! 0. Camera frame: X to the image's right, Y down the image, Z
 //! forward along the view. Pixel (i, j) covers `[i, i+1) × [j, j+1)` from the
 //! top-left corner, so its centre is at (i + ½, j + ½); a point at camera
 //! coordinates (x, y, z) lands at `u = fx·x/z + cx`, `v = fy·y/z + cy`.

@@ -249,6 +249,42 @@ pub fn beside_frames(input: &Path, name: &str) -> Option<PathBuf> {
 
 /// The program that decodes videos.
 const FFMPEG: &str = "ffmpeg";
+/// The program that reads a video's frame rate (it comes with ffmpeg).
+const FFPROBE: &str = "ffprobe";
+
+/// A video's frame rate as its container states it, frames per second:
+/// the average rate, else the nominal one; `None` when it states neither
+/// (a rate of 0/0).
+pub fn video_frame_rate(path: &Path) -> Result<Option<f64>, FrameError> {
+    let label = path.display().to_string();
+    let output = Command::new(FFPROBE)
+        .args(["-v", "error", "-select_streams", "v:0", "-show_entries", "stream=avg_frame_rate,r_frame_rate"])
+        .args(["-of", "default=noprint_wrappers=1"])
+        .arg(path)
+        .stdin(Stdio::null())
+        .output()
+        .map_err(|source| match source.kind() {
+            io::ErrorKind::NotFound => FrameError::FfmpegMissing { path: label.clone(), program: FFPROBE.into() },
+            _ => FrameError::FfmpegIo { path: label.clone(), source },
+        })?;
+    if !output.status.success() {
+        let message = String::from_utf8_lossy(&output.stderr).trim().to_string();
+        return Err(FrameError::VideoFailed { path: label, frames: 0, message });
+    }
+    Ok(parse_frame_rate(&String::from_utf8_lossy(&output.stdout)))
+}
+
+/// The rate from ffprobe's `key=num/den` lines: `avg_frame_rate` when it is
+/// a positive finite number, else `r_frame_rate`.
+fn parse_frame_rate(text: &str) -> Option<f64> {
+    let rate = |key: &str| {
+        let value = text.lines().find_map(|l| l.trim().strip_prefix(key)?.strip_prefix('='))?;
+        let (num, den) = value.split_once('/').unwrap_or((value, "1"));
+        let rate = num.trim().parse::<f64>().ok()? / den.trim().parse::<f64>().ok()?;
+        (rate.is_finite() && rate > 0.0).then_some(rate)
+    };
+    rate("avg_frame_rate").or_else(|| rate("r_frame_rate"))
+}
 
 /// A sequence of frames: the images of a folder, or a video's frames.
 ///
@@ -966,6 +1002,32 @@ mod tests {
         let found = Command::new(FFMPEG).arg("-version").output().is_ok_and(|o| o.status.success());
         assert!(found || std::env::var_os("CI").is_none(), "ffmpeg is not on PATH: under CI it is required");
         found
+    }
+
+    #[test]
+    fn a_frame_rate_is_the_average_else_the_nominal_else_none() {
+        assert_eq!(parse_frame_rate("r_frame_rate=30000/1001\navg_frame_rate=355/12\n"), Some(355.0 / 12.0));
+        assert_eq!(parse_frame_rate("r_frame_rate=25/1\navg_frame_rate=0/0\n"), Some(25.0));
+        assert_eq!(parse_frame_rate("r_frame_rate=0/0\navg_frame_rate=0/0\n"), None);
+        assert_eq!(parse_frame_rate("avg_frame_rate=15\n"), Some(15.0));
+        assert_eq!(parse_frame_rate(""), None);
+    }
+
+    #[test]
+    fn a_video_states_its_own_frame_rate() {
+        if !ffmpeg_on_path() {
+            return;
+        }
+        let dir = TempDir::new().unwrap();
+        let video = dir.path().join("clip.mkv");
+        let made = Command::new(FFMPEG)
+            .args(["-v", "error", "-f", "lavfi", "-i", "testsrc=size=32x24:rate=25", "-frames:v", "5", "-r", "29.97"])
+            .arg(&video)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let rate = video_frame_rate(&video).unwrap().unwrap();
+        assert!((rate - 29.97).abs() < 0.01, "{rate}");
     }
 
     #[test]

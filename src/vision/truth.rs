@@ -6,6 +6,7 @@
 use crate::mocap::body::{Joint, Kind};
 use crate::mocap::pose::{BodyFrame, Pose};
 use std::fmt::Write;
+use std::path::Path;
 
 /// `<joint>_x`, `<joint>_y`, `<joint>_z` for every canonical joint: world
 /// positions in meters.
@@ -50,6 +51,42 @@ pub fn row(frame: usize, time_s: f64, activity: Option<&str>, pose: &Pose, world
     line + "\n"
 }
 
+#[derive(Debug, thiserror::Error)]
+pub enum TruthError {
+    #[error("{path}: cannot read: {source}")]
+    Read { path: String, source: std::io::Error },
+    #[error("{path}: line {line}: {problem}")]
+    Bad { path: String, line: usize, problem: String },
+}
+
+/// The frame rate a truth.csv was rendered at: one over the time between
+/// its first two frames, to a thousandth of a frame a second (`time_s` is
+/// written as k / rate, so a 15 Hz render reads back as 15, not
+/// 14.999999999999998); `None` when it has fewer than two frames.
+pub fn frame_rate(path: &Path) -> Result<Option<f64>, TruthError> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| TruthError::Read { path: name.clone(), source })?;
+    let bad = |line: usize, problem: String| TruthError::Bad { path: name.clone(), line, problem };
+    let mut lines = text.lines();
+    let column = lines
+        .next()
+        .and_then(|h| h.split(',').position(|c| c == "time_s"))
+        .ok_or_else(|| bad(1, "no `time_s` column".into()))?;
+    let times: Vec<f64> = lines
+        .take(2)
+        .enumerate()
+        .map(|(k, l)| {
+            let field = l.split(',').nth(column).unwrap_or("");
+            field.parse::<f64>().map_err(|_| bad(k + 2, format!("time_s `{field}` is not a number")))
+        })
+        .collect::<Result<_, _>>()?;
+    match times[..] {
+        [t0, t1] if t1 > t0 => Ok(Some((1000.0 / (t1 - t0)).round() / 1000.0)),
+        [_, _] => Err(bad(3, "time_s does not advance from the frame before".into())),
+        _ => Ok(None),
+    }
+}
+
 /// A CSV field: quoted when it holds a comma, quote or line break.
 pub fn quoted(text: &str) -> String {
     if text.contains([',', '"', '\n', '\r']) { format!("\"{}\"", text.replace('"', "\"\"")) } else { text.to_string() }
@@ -59,6 +96,25 @@ pub fn quoted(text: &str) -> String {
 mod tests {
     use super::*;
     use crate::mocap::body::{Body, DOF};
+
+    #[test]
+    fn the_frame_rate_is_read_from_the_first_two_times() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("truth.csv");
+        let body = Body::standard();
+        let pose = crate::mocap::pose::Pose::rest(&body);
+        let world = body.forward(&pose);
+        for fps in [15.0, 25.0, 29.97, 60.0] {
+            let rows: String = (0..3).map(|k| row(k, k as f64 / fps, None, &pose, &world)).collect();
+            std::fs::write(&path, header() + &rows).unwrap();
+            assert_eq!(frame_rate(&path).unwrap(), Some(fps));
+        }
+        std::fs::write(&path, header() + &row(0, 0.0, None, &pose, &world)).unwrap();
+        assert_eq!(frame_rate(&path).unwrap(), None);
+        std::fs::write(&path, "frame,time_s\n0,0\n1,soon\n").unwrap();
+        let message = frame_rate(&path).unwrap_err().to_string();
+        assert!(message.contains("truth.csv: line 3: time_s `soon`"), "{message}");
+    }
 
     #[test]
     fn a_row_has_a_value_for_every_column_and_joint_positions_from_forward_kinematics() {

@@ -1,4 +1,4 @@
-//! Learning the vocabulary (GUIDE §3): segment takes, embed the segments by
+//! Learning the vocabulary (docs/method.md, "Learning a vocabulary"): segment takes, embed the segments by
 //! spatio-temporal Isomap, cluster them into primitives, fit each
 //! primitive's latent space and gradient field, and keep the result in one
 //! versioned file.

@@ -1,4 +1,4 @@
-//! Grouping embedded segments into primitives (GUIDE §3.3): k-means from
+//! Grouping embedded segments into primitives: k-means from
 //! linfa-clustering, with the number of primitives chosen by the mean
 //! silhouette unless it is given.
 

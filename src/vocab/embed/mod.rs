@@ -1,4 +1,4 @@
-//! Spatio-temporal Isomap over segments (GUIDE §3.2; Jenkins & Matarić
+//! Spatio-temporal Isomap over segments (Jenkins & Matarić
 //! 2004): each segment, resampled to a fixed number of frames, is one point;
 //! a nearest-neighbour graph joins similar segments; distances between
 //! segments that correspond in space and time are shrunk by constant

@@ -1,4 +1,4 @@
-//! A primitive (GUIDE §3.4): a PCA latent space of its poses (paper eq. 3),
+//! A primitive: a PCA latent space of its poses (paper eq. 3),
 //! a gradient field from the nearest training poses' displacements (eq. 2),
 //! the speed it moves at, and attractor progress along its segments.
 

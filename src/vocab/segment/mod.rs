@@ -1,4 +1,4 @@
-//! Cutting takes into segments (GUIDE §3.1): kinematic-centroid
+//! Cutting takes into segments: kinematic-centroid
 //! segmentation (Jenkins & Matarić 2003), in which each swing of the limbs
 //! away from a posture and back is one segment, and zero-velocity-crossing
 //! segmentation (Fod, Matarić & Jenkins 2002), which cuts where the motion's
