@@ -210,21 +210,21 @@ impl<'v> Tracker<'v> {
         }
         let due = if first { params.window_s } else { params.refine_every_s };
         if state.seen_s + 1e-9 < state.next_s + due {
-            if first && state.seen_s > params.give_up_s && state.samples.len() < params.min_frames {
+            return;
+        }
+        // The window is over: fit if it had enough whole frames, else
+        // wait for more (the first fit, until it gives up) or for the next
+        // window.
+        if state.samples.len() < params.min_frames {
+            if !first {
+                state.next_s = state.seen_s;
+            } else if state.seen_s > params.give_up_s {
                 state.report.note = Some(format!(
                     "no standing frame to calibrate from: fewer than {} frames showed the whole person in the \
                      first {} s; the canonical body was drawn throughout",
                     params.min_frames, params.give_up_s
                 ));
                 state.samples.clear();
-            }
-            return;
-        }
-        // The window is over: fit if it had enough whole frames, else
-        // wait for more (the first fit) or for the next window.
-        if state.samples.len() < params.min_frames {
-            if !first {
-                state.next_s = state.seen_s;
             }
             return;
         }
@@ -252,6 +252,7 @@ impl<'v> Tracker<'v> {
         if !fit.accepted {
             return;
         }
+        report.note = None;
         let physique = if first { fit.physique.clone() } else { blend(&start, &fit.physique, params.refine_rate) };
         report.height_m = physique.body.standing_height();
         (report.arm_share, report.leg_share) = physique.body.shares();
@@ -402,6 +403,25 @@ mod tests {
                 progress: 0.0,
             })
             .collect()
+    }
+
+    #[test]
+    fn a_person_never_seen_whole_is_drawn_canonical_and_the_summary_says_why() {
+        let vocabulary = vocabulary();
+        let mut t = tracker(&vocabulary, Recognition::Likelihood);
+        let params = CalibrationParams { give_up_s: 1.0, ..CalibrationParams::standard(None) };
+        t.params.calibration = Some(params);
+        t.calibration = Calibrating::new(Some(params));
+        // Cut off by the frame's bottom edge in every frame, for the 2 s
+        // window and past the 1 s given.
+        let cut = Mask::from_fn(40, 30, |i, j| (15..25).contains(&i) && j >= 10);
+        for _ in 0..40 {
+            t.step(&cut);
+        }
+        let report = t.calibration();
+        assert!(!report.calibrated, "{report:?}");
+        assert!(report.note.as_deref().is_some_and(|n| n.starts_with("no standing frame")), "{report:?}");
+        assert_eq!(t.body(), &Body::standard());
     }
 
     #[test]
