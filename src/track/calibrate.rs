@@ -1,17 +1,17 @@
 //! The person's build from the silhouettes: standing height, arm and leg
-//! scale, and each part's girth, fitted to the frames of the first seconds
-//! in whatever pose the person holds, then refined slowly. Poses stay in
-//! the canonical joint space; only the drawn body adapts, so one
-//! vocabulary serves every person.
+//! shares of it, and the girth of trunk, arms and legs, fitted to the
+//! frames of the first seconds in whatever pose the person holds, then
+//! refined slowly. Poses stay in the canonical joint space; only the drawn
+//! body adapts, so one vocabulary serves every person.
 //!
 //! The fit holds each sampled frame's tracked joint angles and searches
 //! the build that best explains the silhouettes (the sum of log R, eq. 8,
 //! over the frames), coordinate by coordinate with shrinking steps. A
 //! build changes where the body must stand to cover the same pixels, so
-//! each frame's root is moved with it: its height above the ground scaled
-//! with the pelvis, its distance along the floor from the camera searched
-//! (a taller body stands farther back, which only the feet on the floor
-//! tell apart from a nearer, shorter one).
+//! each frame's root is moved with it: the body stood with its lowest foot
+//! on the floor, its distance along the floor from the camera searched (a
+//! taller body stands farther back, which only the feet on the floor tell
+//! apart from a nearer, shorter one).
 
 use crate::mocap::body::{Body, Joint};
 use crate::mocap::pose::Pose;
@@ -67,7 +67,7 @@ pub struct CalibrationParams {
     /// How far a refinement moves the build towards its own fit.
     pub refine_rate: f64,
     /// The person's standing height when known: then only the limbs'
-    /// scales and the girths are fitted.
+    /// shares and the girths are fitted.
     pub height_m: Option<f64>,
 }
 
@@ -156,7 +156,7 @@ pub struct CalibrationReport {
     pub arm_share: f64,
     pub leg_share: f64,
     pub girth: Girth,
-    /// Frames the first fit scored, and fits made since.
+    /// Frames the first fit scored, and refinements taken since.
     pub frames: usize,
     pub refinements: usize,
     /// Mean log R gained per frame by the first fit over the body it
@@ -167,13 +167,14 @@ pub struct CalibrationReport {
 }
 
 impl CalibrationReport {
-    /// Nothing fitted yet: the canonical body.
+    /// Nothing fitted yet: the canonical body is drawn (`height_given`
+    /// says whether `--height` will set the height once a fit is made).
     pub fn canonical(height_given: Option<f64>) -> CalibrationReport {
         let p = Physique::canonical();
         CalibrationReport {
             calibrated: false,
             note: None,
-            height_m: height_given.unwrap_or(p.body.standing_height()),
+            height_m: p.body.standing_height(),
             height_se_m: 0.0,
             height_given: height_given.is_some(),
             arm_share: 1.0,
