@@ -288,6 +288,8 @@ fn frame_rate(args: &Args, source: &FrameSource) -> anyhow::Result<(f64, RateFro
 const DEFAULT_FPS: f64 = 15.0;
 
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
+    // The options are checked before any file is read; the settings are
+    // made once the frames' rate is known.
     params(&args, DEFAULT_FPS)?;
     refuse_nonempty(&args.output, args.force)?;
     let vocabulary = Vocabulary::load(&args.vocab)?;

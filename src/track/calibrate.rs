@@ -103,15 +103,15 @@ impl Physique {
 /// then the girths of trunk, arms and legs. The head's girth is not
 /// searched: heads vary little, and a few pixels of head cannot tell it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Build([f64; 6]);
+struct Coordinates([f64; 6]);
 
 const HEIGHT: usize = 0;
 
-impl Build {
-    fn of(p: &Physique) -> Build {
+impl Coordinates {
+    fn of(p: &Physique) -> Coordinates {
         let (b, g) = (&p.body, &p.girth);
         let (arms, legs) = b.shares();
-        Build([b.standing_height(), arms, legs, g.trunk, g.arms, g.legs])
+        Coordinates([b.standing_height(), arms, legs, g.trunk, g.arms, g.legs])
     }
 
     fn physique(&self) -> Physique {
@@ -132,6 +132,12 @@ impl Build {
 
     /// First steps of the search, per coordinate.
     const STEPS: [f64; 6] = [0.12, 0.05, 0.05, 0.2, 0.2, 0.2];
+}
+
+/// A build `rate` of the way from `from` to `to`, coordinate by coordinate.
+pub fn blend(from: &Physique, to: &Physique, rate: f64) -> Physique {
+    let (a, b) = (Coordinates::of(from), Coordinates::of(to));
+    Coordinates(std::array::from_fn(|c| a.0[c] + rate * (b.0[c] - a.0[c]))).physique()
 }
 
 /// A frame the fit looks at: its silhouette and the pose tracked in it.
@@ -221,7 +227,7 @@ pub fn fit(camera: &Camera, samples: &[Sample], start: &Physique, height_m: Opti
     let chosen: Vec<&Sample> = spread(samples, FIT_FRAMES);
     let scorers = || Scorer::new(camera.clone(), start.body.clone());
     let placements = std::cell::Cell::new(0u64);
-    let score = |build: &Build| -> f64 {
+    let score = |build: &Coordinates| -> f64 {
         placements.set(placements.get() + chosen.len() as u64);
         let physique = build.physique();
         let scores: Vec<f64> = chosen
@@ -230,20 +236,20 @@ pub fn fit(camera: &Camera, samples: &[Sample], start: &Physique, height_m: Opti
             .collect();
         scores.iter().sum()
     };
-    let mut build = Build::of(start);
+    let mut build = Coordinates::of(start);
     if let Some(h) = height_m {
         build.0[HEIGHT] = h;
     }
-    let initial = score(&Build::of(start));
+    let initial = score(&Coordinates::of(start));
     let mut best = score(&build);
     let (mut steps, rounds) =
-        if refine { (Build::STEPS.map(|s| s / 2.0), REFINE_ROUNDS) } else { (Build::STEPS, ROUNDS) };
+        if refine { (Coordinates::STEPS.map(|s| s / 2.0), REFINE_ROUNDS) } else { (Coordinates::STEPS, ROUNDS) };
     for _ in 0..rounds {
         for (c, &step) in steps.iter().enumerate() {
             if c == HEIGHT && height_m.is_some() {
                 continue;
             }
-            let (low, high) = Build::bounds(c);
+            let (low, high) = Coordinates::bounds(c);
             // The height steps as a share of itself.
             let step = if c == HEIGHT { step * build.0[c] } else { step };
             for sign in [1.0, -1.0] {
@@ -345,7 +351,7 @@ fn placed(scorer: &mut Scorer, camera: &Camera, sample: &Sample, start: &Physiqu
 /// The standard error of the fitted height: each frame's own best height
 /// (a parabola through its scores at the fit and 4% either side), their
 /// spread over √frames.
-fn height_spread(camera: &Camera, chosen: &[&Sample], start: &Physique, build: &Build) -> f64 {
+fn height_spread(camera: &Camera, chosen: &[&Sample], start: &Physique, build: &Coordinates) -> f64 {
     const STEP: f64 = 0.04;
     let at = |scale: f64| {
         let mut b = *build;

@@ -4,7 +4,7 @@
 
 use crate::mocap::body::Body;
 use crate::mocap::pose::Pose;
-use crate::track::calibrate::{self, CalibrationParams, CalibrationReport, Physique, Sample};
+use crate::track::calibrate::{self, CalibrationParams, CalibrationReport, Physique, Sample, blend};
 use crate::track::filter::{Estimate, Filter, FilterParams};
 use crate::track::root::Root;
 use crate::vision::camera::Camera;
@@ -340,26 +340,6 @@ impl Calibrating {
             report.note = Some("calibration off: the canonical body was drawn throughout".into());
         }
         Calibrating { samples: Vec::new(), seen_s: 0.0, next_s: 0.0, report }
-    }
-}
-
-/// A build `rate` of the way from `from` to `to`.
-fn blend(from: &Physique, to: &Physique, rate: f64) -> Physique {
-    let mix = |a: f64, b: f64| a + rate * (b - a);
-    let (p, q) = (from.body.shares(), to.body.shares());
-    let (g, h) = (&from.girth, &to.girth);
-    Physique {
-        body: Body::of_shares(
-            mix(from.body.standing_height(), to.body.standing_height()),
-            mix(p.0, q.0),
-            mix(p.1, q.1),
-        ),
-        girth: crate::vision::shape::Girth {
-            head: mix(g.head, h.head),
-            trunk: mix(g.trunk, h.trunk),
-            arms: mix(g.arms, h.arms),
-            legs: mix(g.legs, h.legs),
-        },
     }
 }
 

@@ -32,10 +32,6 @@ impl Scorer {
         (self.body, self.girth) = (body, girth);
     }
 
-    pub fn girth(&self) -> &Girth {
-        &self.girth
-    }
-
     pub fn camera(&self) -> &Camera {
         &self.camera
     }
