@@ -9,8 +9,9 @@ use imitate::mocap::body::Joint;
 use imitate::mocap::bvh::write_bvh;
 use imitate::mocap::pose::Motion;
 use imitate::mocap::pose::Pose;
+use imitate::track::auto_camera::{self, CameraEstimate, FOV_DEG, Focal, Person, Standing};
 use imitate::track::baseline::{AnnealParams, FullSpaceFilter, mean_training_pose};
-use imitate::track::calibrate::{CalibrationParams, CalibrationReport, HEIGHT_M};
+use imitate::track::calibrate::{CalibrationParams, CalibrationReport, HEIGHT_M, HeightFrom};
 use imitate::track::filter::FilterParams;
 use imitate::track::tracker::{FrameEstimate, Recognition, TrackParams, Tracker};
 use imitate::vision::camera::Camera;
@@ -30,7 +31,8 @@ use std::time::Instant;
 /// virtual trajectory (the winning primitive's pose each frame).
 ///
 /// Writes DIR/trajectory.bvh, DIR/frames.csv, DIR/likelihoods.csv (not
-/// with --baseline) and DIR/summary.json (see docs/formats.md).
+/// with --baseline), DIR/camera.json (the camera used) and
+/// DIR/summary.json (see docs/formats.md).
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The frames: a folder of PNG or JPEG images (silhouettes or color),
@@ -43,11 +45,21 @@ pub struct Args {
     /// --force).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// `front`, `side`, `overhead` (framed at the frames' size) or a
-    /// camera.json file. Default: the camera.json `render` wrote beside
-    /// the frames (in INPUT or its parent folder).
-    #[arg(long, value_name = "PRESET|camera.json")]
+    /// `front`, `side`, `overhead` (framed at the frames' size), a
+    /// camera.json file, or `auto`: estimated from the first seconds of
+    /// silhouettes and the person's height (--height, else the canonical
+    /// body's). Default: the camera.json `render` wrote beside the frames
+    /// (in INPUT or its parent folder), else `auto`.
+    #[arg(long, value_name = "PRESET|camera.json|auto")]
     pub camera: Option<String>,
+    /// The estimated camera's vertical field of view in degrees (10 to
+    /// 150), when known. Default: 48 (a phone's or webcam's video).
+    #[arg(long, value_name = "DEG", conflicts_with = "focal")]
+    pub fov: Option<f64>,
+    /// The estimated camera's focal length in pixels of the frames, when
+    /// known.
+    #[arg(long, value_name = "PX")]
+    pub focal: Option<f64>,
     /// Particles per primitive.
     #[arg(long, default_value_t = 6)]
     pub particles: usize,
@@ -156,26 +168,86 @@ fn params(args: &Args, fps: f64) -> Result<TrackParams, UsageError> {
     {
         return Err(UsageError(format!("--height {h}: a person's height is {} to {} m", HEIGHT_M.0, HEIGHT_M.1)));
     }
+    if let Some(fov) = args.fov
+        && !(fov >= FOV_DEG.0 && fov <= FOV_DEG.1)
+    {
+        return Err(UsageError(format!(
+            "--fov {fov}: a vertical field of view is {} to {} degrees",
+            FOV_DEG.0, FOV_DEG.1
+        )));
+    }
+    if let Some(focal) = args.focal
+        && !(focal.is_finite() && focal > 0.0)
+    {
+        return Err(UsageError(format!("--focal {focal}: a focal length is a positive number of pixels")));
+    }
     let recognition = if args.feedback { Recognition::FEEDBACK } else { Recognition::Likelihood };
     let filter = FilterParams::standard(args.particles, args.lookahead, 1.0 / fps);
     let calibration = (!args.no_calibrate).then(|| CalibrationParams::standard(args.height));
     Ok(TrackParams { filter, recognition, calibration, seed: args.seed })
 }
 
-fn choose_camera(args: &Args, source: &FrameSource) -> anyhow::Result<Camera> {
-    let camera = match (&args.camera, beside_frames(&args.input, "camera.json")) {
-        (Some(choice), _) => camera(choice, source.width() as u32, source.height() as u32)?,
-        (None, Some(path)) => Camera::read(&path)?,
-        (None, None) => {
-            return Err(UsageError(format!(
-                "{}: no camera.json beside the frames; pass --camera (a preset or a camera.json)",
-                args.input.display()
-            ))
-            .into());
-        }
+/// The camera given (`--camera`, or the camera.json beside the frames), or
+/// `None` when it is to be estimated.
+fn given_camera(args: &Args, source: &FrameSource) -> anyhow::Result<Option<Camera>> {
+    let given = match (args.camera.as_deref(), beside_frames(&args.input, "camera.json")) {
+        (Some("auto"), _) | (None, None) => None,
+        (Some(choice), _) => Some((camera(choice, source.width() as u32, source.height() as u32)?, choice.to_string())),
+        (None, Some(path)) => Some((Camera::read(&path)?, path.display().to_string())),
     };
+    let Some((camera, from)) = given else { return Ok(None) };
+    if args.fov.is_some() || args.focal.is_some() {
+        return Err(UsageError(format!(
+            "--fov and --focal set an estimated camera's focal length, but this run's camera is given ({from}); \
+             drop them, or pass --camera auto"
+        ))
+        .into());
+    }
     source.check_size(camera.width(), camera.height())?;
-    Ok(camera)
+    Ok(Some(camera))
+}
+
+/// Reads silhouettes into `pending` until the calibration window's
+/// seconds of the person, with enough whole frames, are in (or it gives
+/// up), and estimates the camera from the whole ones.
+fn estimate_camera(
+    args: &Args,
+    silhouettes: &mut Silhouettes,
+    fps: f64,
+    person: Person,
+    pending: &mut Vec<Mask>,
+) -> anyhow::Result<(Camera, CameraEstimate)> {
+    let window = CalibrationParams::standard(None);
+    let (width, height) = (silhouettes.source().width(), silhouettes.source().height());
+    let mut standings = Vec::new();
+    let mut first_seen: Option<usize> = None;
+    loop {
+        let seen_s = first_seen.map_or(0.0, |first| (pending.len() - first) as f64 / fps);
+        if (seen_s >= window.window_s && standings.len() >= window.min_frames) || seen_s > window.give_up_s {
+            break;
+        }
+        let mut mask = Mask::new(width, height);
+        let Some(read) = silhouettes.next_into(&mut mask) else { break };
+        read?;
+        if mask.count() > 0 {
+            first_seen.get_or_insert(pending.len());
+        }
+        standings.extend(Standing::measure(&mask));
+        pending.push(mask);
+    }
+    let focal = match (args.fov, args.focal) {
+        (Some(deg), _) => Focal::Fov(deg),
+        (None, Some(px)) => Focal::Pixels(px),
+        (None, None) => Focal::Assumed,
+    };
+    auto_camera::estimate(width, height, &standings, person, focal).map_err(|e| {
+        UsageError(format!(
+            "{}: {e} (looked at the first {} s of the person); pass --camera (a preset or a camera.json)",
+            args.input.display(),
+            window.give_up_s
+        ))
+        .into()
+    })
 }
 
 /// The header of `frames.csv`.
@@ -295,8 +367,24 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let vocabulary = Vocabulary::load(&args.vocab)?;
     let source = FrameSource::open(&args.input, Expect::Auto)?;
     let (fps, rate_from) = frame_rate(&args, &source)?;
-    let params = params(&args, fps)?;
-    let camera = choose_camera(&args, &source)?;
+    let mut params = params(&args, fps)?;
+    let given = given_camera(&args, &source)?;
+    let mut silhouettes = Silhouettes::new(&args.input, source, args.background.clone());
+    let mut pending = Vec::new();
+    let (camera, camera_estimate) = match given {
+        Some(camera) => (camera, None),
+        None => {
+            let height = args.height.unwrap_or_else(|| Body::standard().standing_height());
+            let person = Person::of(&Body::of_shares(height, 1.0, 1.0), args.height.is_some());
+            // One camera cannot tell a tall person far away from a short
+            // one near: the height the scene was scaled to is held.
+            if args.height.is_none() {
+                params.calibration = params.calibration.map(|c| c.holding(height, HeightFrom::Camera));
+            }
+            let (camera, estimate) = estimate_camera(&args, &mut silhouettes, fps, person, &mut pending)?;
+            (camera, Some(estimate))
+        }
+    };
     let tracker =
         Tracker::new(&vocabulary, camera.clone(), params).with_context(|| args.vocab.display().to_string())?;
     let anneal = AnnealParams::with_budget(vocabulary.primitives().len() * params.filter.evaluations_per_frame());
@@ -308,14 +396,23 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         }
     };
     let names: Vec<&str> = vocabulary.primitives().iter().map(|p| p.name()).collect();
-    let bar = progress(global, source.frame_count().unwrap_or(0) as u64, "track");
+    let bar = progress(global, silhouettes.source().frame_count().unwrap_or(0) as u64, "track");
     let started = Instant::now();
     let mut mask = Mask::new(camera.width(), camera.height());
     let (mut rows, mut likelihood_rows, mut poses, mut coasted) = (Vec::new(), Vec::new(), Vec::new(), 0usize);
     let mut k = 0;
-    let mut silhouettes = Silhouettes::new(&args.input, source, args.background.clone());
-    while let Some(silhouette) = silhouettes.next_into(&mut mask) {
-        silhouette?;
+    // The frames the camera was estimated from first, then the rest.
+    let mut pending = pending.into_iter();
+    loop {
+        let read = match pending.next() {
+            Some(frame) => {
+                mask = frame;
+                Some(Ok(()))
+            }
+            None => silhouettes.next_into(&mut mask),
+        };
+        let Some(read) = read else { break };
+        read?;
         let (pose, estimate) = follower.step(&mask);
         coasted += usize::from(mask.count() == 0);
         rows.push(row(k, k as f64 / fps, &names, &pose, estimate.as_ref(), follower.body()));
@@ -343,6 +440,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             "name": p.name(), "label": p.majority_label(), "dims": p.dims(),
         })).collect::<Vec<_>>(),
         "camera": camera.spec(),
+        "camera_estimate": camera_estimate,
         "body": follower.calibration(),
         "background": silhouettes.background_used(),
         "settings": params,
@@ -361,6 +459,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     write_dir_atomic(
         &args.output,
         |dir| {
+            std::fs::write(dir.join("camera.json"), camera.to_json()).map_err(io)?;
             write_atomic(&dir.join("trajectory.bvh"), |w| write_bvh(&motion.to_bvh(), w)).map_err(io)?;
             write_atomic(&dir.join("frames.csv"), |w| {
                 w.write_all(header(&names).as_bytes())?;

@@ -20,6 +20,7 @@ use crate::vision::distance::Observation;
 use crate::vision::mask::Mask;
 use crate::vision::scorer::Scorer;
 use crate::vision::shape::Girth;
+use crate::vision::silhouette::person_region;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -66,9 +67,24 @@ pub struct CalibrationParams {
     pub refine_every_s: f64,
     /// How far a refinement moves the build towards its own fit.
     pub refine_rate: f64,
-    /// The person's standing height when known: then only the limbs'
-    /// shares and the girths are fitted.
+    /// The person's standing height when held (told, or the one an
+    /// estimated camera scaled the scene to): then only the limbs' shares
+    /// and the girths are fitted.
     pub height_m: Option<f64>,
+    pub height_from: HeightFrom,
+}
+
+/// Where the drawn body's height comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HeightFrom {
+    /// Fitted to the silhouettes.
+    Fit,
+    /// Told (`--height`).
+    Option,
+    /// Held at the height an estimated camera scaled the scene to: one
+    /// camera cannot tell a tall person far away from a short one near.
+    Camera,
 }
 
 impl CalibrationParams {
@@ -82,7 +98,13 @@ impl CalibrationParams {
             refine_every_s: 6.0,
             refine_rate: 0.25,
             height_m,
+            height_from: if height_m.is_some() { HeightFrom::Option } else { HeightFrom::Fit },
         }
+    }
+
+    /// These settings with the height held at `height_m`, for `from`.
+    pub fn holding(self, height_m: f64, from: HeightFrom) -> CalibrationParams {
+        CalibrationParams { height_m: Some(height_m), height_from: from, ..self }
     }
 }
 
@@ -157,7 +179,9 @@ pub struct CalibrationReport {
     /// (each frame's own best height, spread over √frames); 0 when given.
     pub height_m: f64,
     pub height_se_m: f64,
+    /// Whether `--height` told it; `height_from` says more.
     pub height_given: bool,
+    pub height_from: HeightFrom,
     /// Arm and leg length as multiples of the canonical shares of height.
     pub arm_share: f64,
     pub leg_share: f64,
@@ -173,16 +197,17 @@ pub struct CalibrationReport {
 }
 
 impl CalibrationReport {
-    /// Nothing fitted yet: the canonical body is drawn (`height_given`
-    /// says whether `--height` will set the height once a fit is made).
-    pub fn canonical(height_given: Option<f64>) -> CalibrationReport {
+    /// Nothing fitted yet: the canonical body is drawn (`height_from`
+    /// says what will set the height once a fit is made).
+    pub fn canonical(height_from: HeightFrom) -> CalibrationReport {
         let p = Physique::canonical();
         CalibrationReport {
             calibrated: false,
             note: None,
             height_m: p.body.standing_height(),
             height_se_m: 0.0,
-            height_given: height_given.is_some(),
+            height_given: height_from == HeightFrom::Option,
+            height_from,
             arm_share: 1.0,
             leg_share: 1.0,
             girth: p.girth,
@@ -198,7 +223,7 @@ impl CalibrationReport {
 #[derive(Clone, Debug)]
 pub struct Fit {
     /// Whether the build explains the frames better than the one it
-    /// started from by [`MIN_GAIN`] (always when the height was given).
+    /// started from by [`MIN_GAIN`].
     pub accepted: bool,
     pub physique: Physique,
     /// The last sample's pose re-rooted for the fitted build.
@@ -210,13 +235,18 @@ pub struct Fit {
     pub evaluations: u64,
 }
 
-/// Whether a silhouette shows the whole person: some pixels, none on the
-/// frame's border (a cut-off body would be fitted too small).
+/// Whether a silhouette shows the whole person: its person's regions
+/// (specks aside) are not empty and does not touch the frame's border (a cut-off
+/// body would be fitted too small).
 pub fn whole(mask: &Mask) -> bool {
+    let person = person_region(mask);
+    person.count() > 0 && !touches_border(&person)
+}
+
+/// Whether any pixel of `mask` lies on the frame's border.
+pub fn touches_border(mask: &Mask) -> bool {
     let (w, h) = (mask.width(), mask.height());
-    mask.count() > 0
-        && (0..w).all(|i| !mask.get(i, 0) && !mask.get(i, h - 1))
-        && (0..h).all(|j| !mask.get(0, j) && !mask.get(w - 1, j))
+    (0..w).any(|i| mask.get(i, 0) || mask.get(i, h - 1)) || (0..h).any(|j| mask.get(0, j) || mask.get(w - 1, j))
 }
 
 /// Fits the build to `samples` (poses tracked with `start`), starting
@@ -278,7 +308,7 @@ pub fn fit(camera: &Camera, samples: &[Sample], start: &Physique, height_m: Opti
     let (_, last_pose) = placed(&mut scorer, camera, last, start, &physique);
     let log_likelihood_gain = (best - initial) / chosen.len() as f64;
     Some(Fit {
-        accepted: height_m.is_some() || log_likelihood_gain >= MIN_GAIN,
+        accepted: log_likelihood_gain >= MIN_GAIN,
         physique,
         last_pose,
         height_se_m,

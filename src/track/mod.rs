@@ -7,6 +7,7 @@
 //! [`baseline`] is the full-space annealed filter the method is measured
 //! against.
 
+pub mod auto_camera;
 pub mod baseline;
 pub mod calibrate;
 pub mod cone;

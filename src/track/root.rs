@@ -9,6 +9,7 @@ use crate::vision::camera::Camera;
 use crate::vision::distance::Observation;
 use crate::vision::mask::Mask;
 use crate::vision::scorer::Scorer;
+use crate::vision::silhouette::person_region;
 use glam::DVec3;
 use rand::Rng;
 use rand_distr::StandardNormal;
@@ -40,8 +41,12 @@ impl Root {
     /// person is put at the distance of the camera's `look_at`. Seen from
     /// above, the lowest row is no longer the feet, and the ray through the
     /// silhouette's centre of mass meets the pelvis's height near the
-    /// pelvis. `None` for an empty silhouette.
+    /// pelvis. Only the silhouette's largest region counts. `None` for an
+    /// empty silhouette.
     pub fn from_silhouette(camera: &Camera, mask: &Mask, pelvis_height: f64, heading: f64) -> Option<Root> {
+        // The person's own region: a speck below them would put their
+        // feet nearer the camera.
+        let mask = &person_region(mask);
         let (mut count, mut sum_x, mut sum_y, mut bottom) = (0usize, 0usize, 0usize, 0usize);
         for (y, row) in mask.pixels().chunks_exact(mask.width()).enumerate() {
             let n = row.iter().filter(|&&p| p != 0).count();

@@ -4,7 +4,7 @@
 
 use crate::mocap::body::Body;
 use crate::mocap::pose::Pose;
-use crate::track::calibrate::{self, CalibrationParams, CalibrationReport, Physique, Sample, blend};
+use crate::track::calibrate::{self, CalibrationParams, CalibrationReport, HeightFrom, Physique, Sample, blend};
 use crate::track::filter::{Estimate, Filter, FilterParams};
 use crate::track::root::Root;
 use crate::vision::camera::Camera;
@@ -112,7 +112,12 @@ impl<'v> Tracker<'v> {
         if primitives.is_empty() {
             return Err(TrackError::EmptyVocabulary);
         }
-        let physique = Physique::canonical();
+        // A held height is drawn from the first frame; a fitted one from
+        // the first fit.
+        let physique = match params.calibration.and_then(|c| c.height_m) {
+            Some(h) => Physique { body: Body::of_shares(h, 1.0, 1.0), ..Physique::canonical() },
+            None => Physique::canonical(),
+        };
         let body = &physique.body;
         // Until a silhouette places it, the person stands where the camera looks.
         let look_at = DVec3::from_array(camera.spec().look_at);
@@ -127,7 +132,7 @@ impl<'v> Tracker<'v> {
             })
             .collect();
         let n = primitives.len();
-        let calibration = Calibrating::new(params.calibration);
+        let calibration = Calibrating::new(params.calibration, body.standing_height());
         Ok(Tracker {
             filters,
             camera,
@@ -334,8 +339,9 @@ struct Calibrating {
 }
 
 impl Calibrating {
-    fn new(params: Option<CalibrationParams>) -> Calibrating {
-        let mut report = CalibrationReport::canonical(params.and_then(|p| p.height_m));
+    fn new(params: Option<CalibrationParams>, height_m: f64) -> Calibrating {
+        let mut report = CalibrationReport::canonical(params.map_or(HeightFrom::Fit, |p| p.height_from));
+        report.height_m = height_m;
         if params.is_none() {
             report.note = Some("calibration off: the canonical body was drawn throughout".into());
         }
@@ -391,7 +397,7 @@ mod tests {
         let mut t = tracker(&vocabulary, Recognition::Likelihood);
         let params = CalibrationParams { give_up_s: 1.0, ..CalibrationParams::standard(None) };
         t.params.calibration = Some(params);
-        t.calibration = Calibrating::new(Some(params));
+        t.calibration = Calibrating::new(Some(params), t.body().standing_height());
         // Cut off by the frame's bottom edge in every frame, for the 2 s
         // window and past the 1 s given.
         let cut = Mask::from_fn(40, 30, |i, j| (15..25).contains(&i) && j >= 10);

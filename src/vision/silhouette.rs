@@ -584,6 +584,27 @@ impl Components {
     }
 }
 
+/// The person in `mask`: its 8-connected regions of at least
+/// [`PERSON_SHARE`] of the largest one's area (specks set aside, a limb cut
+/// off by a thin gap kept); empty for an empty mask.
+pub fn person_region(mask: &Mask) -> Mask {
+    let (width, height) = (mask.width(), mask.height());
+    let mut components = Components::default();
+    components.label(mask.pixels(), width, height, 1, true);
+    let largest = components.area.iter().copied().max().unwrap_or(0);
+    let mut region = Mask::new(width, height);
+    for (run, &root) in components.runs.iter().zip(&components.parent) {
+        if f64::from(components.area[root as usize]) >= PERSON_SHARE * f64::from(largest) {
+            region.fill_span(run.y as usize, run.x0 as usize, run.x1 as usize);
+        }
+    }
+    region
+}
+
+/// The share of the largest region's area a region needs to count as part
+/// of the person: a hand is about 2% of a silhouette, a speck far less.
+const PERSON_SHARE: f64 = 0.01;
+
 /// The first index at or after `from` where `row` holds `value` (0 or 1),
 /// or `row.len()`. Skips eight pixels at a time where none can match.
 fn find(row: &[u8], from: usize, value: u8) -> usize {
