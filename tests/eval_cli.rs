@@ -42,7 +42,7 @@ fn a_quick_evaluation_reports_every_trial_with_the_numbers_of_its_metrics_json()
     let report = dir.join("a");
     let metrics = json(&report.join("metrics.json"));
     assert_eq!(metrics["schema"], "imitate-eval/1");
-    let mut trials = vec!["particles", "recognition", "speed", "viewpoint", "baseline"];
+    let mut trials = vec!["particles", "recognition", "speed", "viewpoint", "baseline", "person"];
     if real != "absent" {
         trials.extend(["real", "mocap_styles"]);
     }
@@ -59,6 +59,7 @@ fn a_quick_evaluation_reports_every_trial_with_the_numbers_of_its_metrics_json()
         "filmstrip-fast.png",
         "filmstrip-punch.png",
         "filmstrip-overhead.png",
+        "filmstrip-person.png",
     ] {
         assert!(report.join(file).is_file(), "{file} missing");
     }

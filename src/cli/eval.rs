@@ -1,6 +1,7 @@
 //! `imitate eval`: the paper's trials, run end to end, as a report.
 
 mod mocap;
+mod person;
 
 use super::report::silhouettes;
 use super::{Global, Outcome, UsageError, arg, invoke, refuse_nonempty};
@@ -66,6 +67,9 @@ struct Plan {
     speeds: Vec<f64>,
     /// Particle counts of the eq. 7 / eq. 10 and baseline comparisons.
     compared: Vec<usize>,
+    /// Test bodies of "the person is not the model", and their particles.
+    bodies: Vec<&'static str>,
+    person_particles: usize,
 }
 
 impl Plan {
@@ -76,6 +80,9 @@ impl Plan {
             particles: if quick { vec![6, 25, 100] } else { vec![6, 12, 25, 50, 100, 200] },
             speeds: if quick { vec![0.25, 1.0, 4.0] } else { vec![0.03, 0.25, 1.0, 2.0, 4.0, 8.0] },
             compared: if quick { vec![6] } else { vec![6, 200] },
+            // The model itself, the thinnest and thickest builds, and clothes.
+            bodies: if quick { vec!["capsules", "heavy"] } else { vec!["capsules", "slight", "heavy", "skirt"] },
+            person_particles: if quick { 6 } else { 25 },
         }
     }
 }
@@ -144,9 +151,16 @@ impl Work {
 
     /// Renders `bvh` (labelled by `labels`) as seen by `camera` into `name`.
     fn render(&self, name: &str, bvh: &Path, labels: &Path, camera: &str) -> anyhow::Result<Video> {
+        self.render_with(name, bvh, labels, &["--camera", camera])
+    }
+
+    /// Renders `bvh` (labelled by `labels`) with `render` `options` into
+    /// `name`.
+    fn render_with(&self, name: &str, bvh: &Path, labels: &Path, options: &[&str]) -> anyhow::Result<Video> {
         self.step(&format!("render {name}"));
         let out = self.path(name);
-        invoke(&["render", &arg(bvh), "-o", &arg(&out), "--labels", &arg(labels), "--camera", camera, "--force"])?;
+        let args = ["render", &arg(bvh), "-o", &arg(&out), "--labels", &arg(labels), "--force"];
+        invoke(&[&args[..], options].concat())?;
         Ok(Video { name: name.to_string(), frames: out.join("frames"), truth: out.join("truth.csv") })
     }
 
@@ -346,9 +360,15 @@ fn evaluate(args: &Args, global: Global, dir: &Path) -> anyhow::Result<Outcome> 
     let vocabulary = Vocabulary::load(&work.vocab)?;
     let held_out = args.seed + 1000;
     // Distinct settings (trials share some): trial one, eq. 7, speed with the
-    // punch, side and overhead, the full-space baseline, the real takes.
-    let settings =
-        plan.particles.len() + plan.compared.len() + 2 * (plan.speeds.len() + 1) + 2 + plan.compared.len() + 2;
+    // punch, side and overhead, the full-space baseline, the real takes, the
+    // person who is not the model.
+    let settings = plan.particles.len()
+        + plan.compared.len()
+        + 2 * (plan.speeds.len() + 1)
+        + 2
+        + plan.compared.len()
+        + 2
+        + 6 * plan.bodies.len();
     work.bar.set_length((settings * plan.seeds.len()) as u64);
     let front = work.synth("front", SEQUENCE, 3, held_out, 1.0, "front")?;
     let first = work.run_dir(&front, &["--particles", &plan.particles[0].to_string(), "--feedback"], plan.seeds[0]);
@@ -358,6 +378,7 @@ fn evaluate(args: &Args, global: Global, dir: &Path) -> anyhow::Result<Outcome> 
         speed(&work, &plan, held_out)?,
         viewpoint(&work, &front, held_out)?,
         baseline(&work, &plan, &front)?,
+        person::trial(&work, &plan, &front)?,
     ];
     if let Some(real) = real_trial(&work, &args.real)? {
         trials.push(real);
