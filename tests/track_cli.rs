@@ -220,6 +220,17 @@ fn bad_input_is_refused_with_nothing_written() {
     let small = dir.join("small/frames");
     let args = ["track", small.to_str().unwrap(), "--vocab", vocab, "-o", "out", "--camera", camera.to_str().unwrap()];
     refused(dir, &args, 1, "the camera is 160×120");
+    // A camera upside down: the person's feet above its horizon.
+    let flipped =
+        fs::read_to_string(&camera).unwrap().replace("\"up\": [\n    0.0,\n    1.0,", "\"up\": [\n    0.0,\n    -1.0,");
+    assert!(flipped.contains("-1.0"), "{flipped}");
+    fs::write(dir.join("flipped.json"), flipped).unwrap();
+    refused(
+        dir,
+        &["track", frames, "--vocab", vocab, "-o", "out", "--camera", "flipped.json"],
+        1,
+        "looks away from the floor",
+    );
     // A field of view no camera has, and a focal length for a camera that
     // is given rather than estimated.
     for fov in ["5", "151"] {

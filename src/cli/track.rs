@@ -13,6 +13,7 @@ use imitate::track::auto_camera::{self, CameraEstimate, FOV_DEG, Focal, Person, 
 use imitate::track::baseline::{AnnealParams, FullSpaceFilter, mean_training_pose};
 use imitate::track::calibrate::{CalibrationParams, CalibrationReport, HEIGHT_M, HeightFrom};
 use imitate::track::filter::FilterParams;
+use imitate::track::root::Root;
 use imitate::track::tracker::{FrameEstimate, Recognition, TrackParams, Tracker};
 use imitate::vision::camera::Camera;
 use imitate::vision::frames::{Expect, FrameSource, beside_frames, video_frame_rate};
@@ -187,9 +188,9 @@ fn params(args: &Args, fps: f64) -> Result<TrackParams, UsageError> {
     Ok(TrackParams { filter, recognition, calibration, seed: args.seed })
 }
 
-/// The camera given (`--camera`, or the camera.json beside the frames), or
-/// `None` when it is to be estimated.
-fn given_camera(args: &Args, source: &FrameSource) -> anyhow::Result<Option<Camera>> {
+/// The camera given (`--camera`, or the camera.json beside the frames) and
+/// where it came from, or `None` when it is to be estimated.
+fn given_camera(args: &Args, source: &FrameSource) -> anyhow::Result<Option<(Camera, String)>> {
     let given = match (args.camera.as_deref(), beside_frames(&args.input, "camera.json")) {
         (Some("auto"), _) | (None, None) => None,
         (Some(choice), _) => Some((camera(choice, source.width() as u32, source.height() as u32)?, choice.to_string())),
@@ -204,7 +205,7 @@ fn given_camera(args: &Args, source: &FrameSource) -> anyhow::Result<Option<Came
         .into());
     }
     source.check_size(camera.width(), camera.height())?;
-    Ok(Some(camera))
+    Ok(Some((camera, from)))
 }
 
 /// Reads silhouettes into `pending` until the calibration window's
@@ -213,10 +214,12 @@ fn given_camera(args: &Args, source: &FrameSource) -> anyhow::Result<Option<Came
 fn estimate_camera(
     args: &Args,
     silhouettes: &mut Silhouettes,
-    fps: f64,
+    vocabulary: &Vocabulary,
+    params: TrackParams,
     person: Person,
     pending: &mut Vec<Mask>,
 ) -> anyhow::Result<(Camera, CameraEstimate)> {
+    let fps = 1.0 / params.filter.frame_time_s;
     let window = CalibrationParams::standard(None);
     let (width, height) = (silhouettes.source().width(), silhouettes.source().height());
     let mut standings = Vec::new();
@@ -240,14 +243,22 @@ fn estimate_camera(
         (None, Some(px)) => Focal::Pixels(px),
         (None, None) => Focal::Assumed,
     };
-    auto_camera::estimate(width, height, &standings, person, focal).map_err(|e| {
+    let mut evaluations = 0;
+    let judge = &mut |camera: &Camera| {
+        let (score, spent) = auto_camera::explained(vocabulary, camera, pending, params);
+        evaluations += spent;
+        score
+    };
+    let found = auto_camera::estimate(width, height, &standings, person, focal, judge);
+    let (camera, mut estimate) = found.map_err(|e| {
         UsageError(format!(
             "{}: {e} (looked at the first {} s of the person); pass --camera (a preset or a camera.json)",
             args.input.display(),
             window.give_up_s
         ))
-        .into()
-    })
+    })?;
+    estimate.evaluations = evaluations;
+    Ok((camera, estimate))
 }
 
 /// The header of `frames.csv`.
@@ -368,11 +379,13 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let source = FrameSource::open(&args.input, Expect::Auto)?;
     let (fps, rate_from) = frame_rate(&args, &source)?;
     let mut params = params(&args, fps)?;
-    let given = given_camera(&args, &source)?;
+    let mut given = given_camera(&args, &source)?;
+    // The timing includes estimating the camera.
+    let started = Instant::now();
     let mut silhouettes = Silhouettes::new(&args.input, source, args.background.clone());
     let mut pending = Vec::new();
-    let (camera, camera_estimate) = match given {
-        Some(camera) => (camera, None),
+    let (camera, camera_estimate) = match &given {
+        Some((camera, _)) => (camera.clone(), None),
         None => {
             let height = args.height.unwrap_or_else(|| Body::standard().standing_height());
             let person = Person::of(&Body::of_shares(height, 1.0, 1.0), args.height.is_some());
@@ -381,7 +394,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             if args.height.is_none() {
                 params.calibration = params.calibration.map(|c| c.holding(height, HeightFrom::Camera));
             }
-            let (camera, estimate) = estimate_camera(&args, &mut silhouettes, fps, person, &mut pending)?;
+            let (camera, estimate) =
+                estimate_camera(&args, &mut silhouettes, &vocabulary, params, person, &mut pending)?;
             (camera, Some(estimate))
         }
     };
@@ -397,7 +411,6 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     };
     let names: Vec<&str> = vocabulary.primitives().iter().map(|p| p.name()).collect();
     let bar = progress(global, silhouettes.source().frame_count().unwrap_or(0) as u64, "track");
-    let started = Instant::now();
     let mut mask = Mask::new(camera.width(), camera.height());
     let (mut rows, mut likelihood_rows, mut poses, mut coasted) = (Vec::new(), Vec::new(), Vec::new(), 0usize);
     let mut k = 0;
@@ -413,6 +426,17 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         };
         let Some(read) = read else { break };
         read?;
+        // A given camera must see the person's feet below its horizon on
+        // the first frame that shows them.
+        if let Some((_, from)) = given.take_if(|_| mask.count() > 0)
+            && !Root::feet_below_horizon(&camera, &mask)
+        {
+            bail!(
+                "{from}: the camera sees the person's feet above its horizon in {}: it looks away from the floor \
+                 they stand on (check its `look_at` and `up`)",
+                args.input.display()
+            );
+        }
         let (pose, estimate) = follower.step(&mask);
         coasted += usize::from(mask.count() == 0);
         rows.push(row(k, k as f64 / fps, &names, &pose, estimate.as_ref(), follower.body()));
@@ -428,7 +452,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         bail!("{}: no frames", args.input.display());
     }
     let seconds = started.elapsed().as_secs_f64();
-    let evaluations = follower.evaluations();
+    let evaluations = follower.evaluations() + camera_estimate.as_ref().map_or(0, |e| e.evaluations);
     let motion = Motion { body: follower.body().clone(), frame_time_s: 1.0 / fps, poses };
     let summary = serde_json::json!({
         "input": args.input.display().to_string(),

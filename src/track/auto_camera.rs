@@ -22,10 +22,12 @@
 
 use crate::mocap::body::{Body, Joint};
 use crate::mocap::pose::Pose;
-use crate::track::calibrate::touches_border;
+use crate::track::calibrate::{CalibrationParams, touches_border};
+use crate::track::tracker::{TrackParams, Tracker};
 use crate::vision::camera::{Camera, CameraSpec};
 use crate::vision::mask::Mask;
 use crate::vision::silhouette::person_region;
+use crate::vocab::vocabulary::Vocabulary;
 use glam::DVec3;
 
 /// Vertical fields of view `--fov` accepts, degrees.
@@ -43,6 +45,17 @@ const ROW_NOISE_SHARE: f64 = 0.01;
 /// A frame whose head row misses by more than this many noise units is
 /// taken for one where something (a raised hand) stands above the head.
 const OUTLIER_UNITS: f64 = 3.0;
+/// The camera heights compared with the prior's choice when the person
+/// stands still, meters: the range people film from.
+const PROBE_HEIGHTS_M: [f64; 4] = [0.8, 1.1, 1.7, 2.0];
+/// The mean log R per frame another camera of the curve must explain the
+/// frames better by than the prior's to be taken: where the perspective
+/// hardly differs along the curve, tracking seeds disagree on the best by
+/// about this much.
+const MIN_PROBE_GAIN: f64 = 0.01;
+/// Frames with a silhouette the judge lets the filters lock on in before
+/// it counts.
+const LOCK_ON_FRAMES: usize = 3;
 /// How far apart (as a share of their distance) the person's nearest and
 /// farthest tenth of frames must stand for the frames to be fitted one by
 /// one: less is sway, and the feet's and head's rows then mostly tell how
@@ -151,11 +164,26 @@ pub struct CameraEstimate {
     /// How far the person's distance varied over the frames, meters.
     pub depth_range_m: f64,
     /// `frames` when the person's changing distance fixed the height and
-    /// tilt, `prior` when they stood still and the prior on the camera's
-    /// height chose among the cameras that see them alike.
+    /// tilt. When they stood still, the cameras that see them alike were
+    /// compared by how well the tracker explains the frames through each
+    /// (`probes`, the prior's first): `likelihood` when one did clearly
+    /// better than the prior's choice, else `prior`.
     pub decided_by: &'static str,
+    pub probes: Vec<Probe>,
+    /// Likelihood evaluations the comparison made (also counted in the
+    /// run's).
+    pub evaluations: u64,
     /// Root-mean-square head-row residual over the frames kept, pixels.
     pub rms_residual_px: f64,
+}
+
+/// One camera of the curve compared, and its score.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Probe {
+    pub camera_height_m: f64,
+    pub tilt_deg: f64,
+    /// The judge's score: the mean log R of the tracker's estimates.
+    pub score: f64,
 }
 
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -230,6 +258,86 @@ impl Geometry<'_> {
         self.misfit(tilt, h).map(|m| m + prior)
     }
 
+    /// The tilt (degrees) at which a camera `h` m high fits the frames
+    /// best; `None` when at no tilt do their feet show below the horizon.
+    fn tilt_at(&self, h: f64) -> Option<f64> {
+        let misfit = |tilt_deg: f64| self.misfit(f64::to_radians(tilt_deg), h);
+        let steps = 1250;
+        let mut best = (0..=steps)
+            .map(|i| TILT_DEG.0 + (TILT_DEG.1 - TILT_DEG.0) * f64::from(i) / f64::from(steps))
+            .filter_map(|t| misfit(t).map(|m| (t, m)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))?;
+        let mut step = 0.05;
+        while step > 1e-4 {
+            match [best.0 - step, best.0 + step]
+                .into_iter()
+                .filter_map(|t| misfit(t).map(|m| (t, m)))
+                .find(|c| c.1 < best.1)
+            {
+                Some(better) => best = better,
+                None => step /= 2.0,
+            }
+        }
+        Some(best.0)
+    }
+
+    /// The camera tilted `tilt` degrees at `h` m, and its report.
+    #[allow(clippy::too_many_arguments)]
+    fn camera(
+        &self,
+        width: usize,
+        height: usize,
+        tilt: f64,
+        h: f64,
+        focal: Focal,
+        decided_by: &'static str,
+        probes: Vec<Probe>,
+    ) -> Result<(Camera, CameraEstimate), AutoCameraError> {
+        let t = tilt.to_radians();
+        let kept: Vec<(f64, f64)> = self
+            .frames
+            .iter()
+            .filter_map(|s| self.predict(s, t, h))
+            .filter(|(r, _)| r.abs() <= OUTLIER_UNITS * self.noise)
+            .collect();
+        let distances: Vec<f64> = kept.iter().map(|(_, d)| *d).collect();
+        let distance = median(&distances).ok_or(AutoCameraError::NoCamera)?;
+        let nearest = distances.iter().copied().fold(f64::MAX, f64::min);
+        let farthest = distances.iter().copied().fold(f64::MIN, f64::max);
+        let rms = (kept.iter().map(|(r, _)| r * r).sum::<f64>() / kept.len() as f64).sqrt();
+        let position = DVec3::new(0.0, h, distance);
+        let look_at = position + DVec3::new(0.0, -t.sin(), -t.cos()) * distance.max(1.0);
+        let spec = CameraSpec {
+            width: width as u32,
+            height: height as u32,
+            fx: self.f,
+            fy: self.f,
+            cx: width as f64 / 2.0,
+            cy: self.cy,
+            position: position.to_array(),
+            look_at: look_at.to_array(),
+            up: [0.0, 1.0, 0.0],
+        };
+        let camera = Camera::new(spec, "the estimated camera").map_err(|_| AutoCameraError::NoCamera)?;
+        let report = CameraEstimate {
+            frames: self.frames.len(),
+            outliers: self.frames.len() - kept.len(),
+            person_height_m: self.person.height_m,
+            person_height_from: if self.person.given { "option" } else { "assumed" },
+            fov_deg: 2.0 * (self.cy / self.f).atan().to_degrees(),
+            focal_from: focal.source(),
+            camera_height_m: h,
+            tilt_deg: tilt,
+            distance_m: distance,
+            depth_range_m: farthest - nearest,
+            decided_by,
+            probes,
+            evaluations: 0,
+            rms_residual_px: rms,
+        };
+        Ok((camera, report))
+    }
+
     /// The tilt (degrees) and height (m) of least cost: a coarse grid
     /// over tilt and log height, then a pattern search from the best cell
     /// (the capped misfits make the surface bumpy, so no gradient method is
@@ -271,20 +379,24 @@ impl Geometry<'_> {
 }
 
 /// Estimates the camera of `width` × `height` frames from `frames` (whole
-/// silhouettes) of `person`.
+/// silhouettes) of `person`. When the person stood still, the cameras of
+/// the curve that sees them alike are compared by `judge` (higher is
+/// better: how well the tracker explains the frames through each), the
+/// prior's choice among them first.
 pub fn estimate(
     width: usize,
     height: usize,
     frames: &[Standing],
     person: Person,
     focal: Focal,
+    judge: &mut dyn FnMut(&Camera) -> f64,
 ) -> Result<(Camera, CameraEstimate), AutoCameraError> {
     if frames.is_empty() {
         return Err(AutoCameraError::NoStandingFrame);
     }
     let f = focal.pixels(height);
-    let (cx, cy) = (width as f64 / 2.0, height as f64 / 2.0);
     let noise = (ROW_NOISE_SHARE * height as f64).max(1.0);
+    let cy = height as f64 / 2.0;
     // First the camera of the typical frame (each row's median): with
     // one frame the head and feet rows fit exactly along a curve of
     // cameras, and the prior on the height chooses among them.
@@ -295,57 +407,32 @@ pub fn estimate(
         u: column(|s| s.u).ok_or(AutoCameraError::NoStandingFrame)?,
     };
     let still = Geometry { frames: std::slice::from_ref(&typical), person, f, cy, noise };
-    let (mut tilt, mut h) = still.search().ok_or(AutoCameraError::NoCamera)?;
+    let (tilt, h) = still.search().ok_or(AutoCameraError::NoCamera)?;
     // A person who came nearer or went farther tells the horizon: then
     // every frame is fitted.
     let geometry = Geometry { frames, person, f, cy, noise };
     let distances: Vec<f64> =
         frames.iter().filter_map(|s| geometry.predict(s, tilt.to_radians(), h)).map(|(_, d)| d).collect();
     let (near, far) = (quantile(&distances, 0.1), quantile(&distances, 0.9));
-    let moved = far - near > MOVED_SHARE * (near + far) / 2.0;
-    if moved && let Some(found) = geometry.search() {
-        (tilt, h) = found;
+    if far - near > MOVED_SHARE * (near + far) / 2.0
+        && let Some((tilt, h)) = geometry.search()
+    {
+        return geometry.camera(width, height, tilt, h, focal, "frames", Vec::new());
     }
-    let t = tilt.to_radians();
-    let kept: Vec<(f64, f64)> = frames
-        .iter()
-        .filter_map(|s| geometry.predict(s, t, h))
-        .filter(|(r, _)| r.abs() <= OUTLIER_UNITS * geometry.noise)
-        .collect();
-    let distances: Vec<f64> = kept.iter().map(|(_, d)| *d).collect();
-    let distance = median(&distances).ok_or(AutoCameraError::NoCamera)?;
-    let nearest = distances.iter().copied().fold(f64::MAX, f64::min);
-    let farthest = distances.iter().copied().fold(f64::MIN, f64::max);
-    let rms = (kept.iter().map(|(r, _)| r * r).sum::<f64>() / kept.len() as f64).sqrt();
-    let position = DVec3::new(0.0, h, distance);
-    let look_at = position + DVec3::new(0.0, -t.sin(), -t.cos()) * distance.max(1.0);
-    let spec = CameraSpec {
-        width: width as u32,
-        height: height as u32,
-        fx: f,
-        fy: f,
-        cx,
-        cy,
-        position: position.to_array(),
-        look_at: look_at.to_array(),
-        up: [0.0, 1.0, 0.0],
-    };
-    let camera = Camera::new(spec, "the estimated camera").map_err(|_| AutoCameraError::NoCamera)?;
-    let report = CameraEstimate {
-        frames: frames.len(),
-        outliers: frames.len() - kept.len(),
-        person_height_m: person.height_m,
-        person_height_from: if person.given { "option" } else { "assumed" },
-        fov_deg: 2.0 * (height as f64 / 2.0 / f).atan().to_degrees(),
-        focal_from: focal.source(),
-        camera_height_m: h,
-        tilt_deg: tilt,
-        distance_m: distance,
-        depth_range_m: farthest - nearest,
-        decided_by: if moved { "frames" } else { "prior" },
-        rms_residual_px: rms,
-    };
-    Ok((camera, report))
+    // Standing still: the curve's cameras at each probed height, judged.
+    let mut probes = vec![(h, tilt)];
+    probes.extend(PROBE_HEIGHTS_M.iter().filter_map(|&hh| still.tilt_at(hh).map(|t| (hh, t))));
+    let mut judged = Vec::new();
+    for (hh, t) in probes {
+        let (camera, _) = geometry.camera(width, height, t, hh, focal, "", Vec::new())?;
+        judged.push(Probe { camera_height_m: hh, tilt_deg: t, score: judge(&camera) });
+    }
+    // The prior's camera unless another explains the frames clearly better.
+    let prior = judged[0];
+    let best = judged.iter().copied().fold(prior, |b, p| if p.score > b.score { p } else { b });
+    let (chosen, decided_by) =
+        if best.score > prior.score + MIN_PROBE_GAIN { (best, "likelihood") } else { (prior, "prior") };
+    geometry.camera(width, height, chosen.tilt_deg, chosen.camera_height_m, focal, decided_by, judged)
 }
 
 /// The `q` quantile of `values` (nearest rank); 0 when empty.
@@ -353,6 +440,31 @@ fn quantile(values: &[f64], q: f64) -> f64 {
     let mut v = values.to_vec();
     v.sort_by(f64::total_cmp);
     v.get(((v.len().max(1) - 1) as f64 * q).round() as usize).copied().unwrap_or(0.0)
+}
+
+/// How well the tracker explains `masks` through `camera`: the mean log R
+/// (eq. 8) of the frames' arbitrated estimates, once the filters have had
+/// [`LOCK_ON_FRAMES`] frames to lock on. The body is the one `params`
+/// start from; it is not fitted here.
+/// Also the likelihood evaluations it made.
+pub fn explained(vocabulary: &Vocabulary, camera: &Camera, masks: &[Mask], params: TrackParams) -> (f64, u64) {
+    let held = params.calibration.map(|c| CalibrationParams { window_s: f64::MAX, give_up_s: f64::MAX, ..c });
+    let Ok(mut tracker) = Tracker::new(vocabulary, camera.clone(), TrackParams { calibration: held, ..params }) else {
+        return (f64::MIN, 0);
+    };
+    let (mut total, mut counted, mut seen) = (0.0, 0usize, 0usize);
+    for mask in masks {
+        let estimate = tracker.step(mask);
+        if let Some(r) = estimate.estimates[estimate.winner].likelihood {
+            seen += 1;
+            if seen > LOCK_ON_FRAMES {
+                total += r.max(f64::MIN_POSITIVE).ln();
+                counted += 1;
+            }
+        }
+    }
+    let score = if counted == 0 { f64::MIN } else { total / counted as f64 };
+    (score, tracker.evaluations())
 }
 
 fn median(values: &[f64]) -> Option<f64> {
@@ -415,7 +527,8 @@ mod tests {
         for (h, tilt, d) in [(0.9, 5.0, 4.0), (2.0, 25.0, 4.0), (1.6, 12.0, 5.0)] {
             let cam = camera(h, tilt, d, 50.0);
             let places: Vec<(f64, f64)> = (0..8).map(|k| (0.0, 1.5 - 0.4 * f64::from(k))).collect();
-            let (found, report) = estimate(320, 240, &standings(&cam, &places), person, Focal::Fov(50.0)).unwrap();
+            let (found, report) =
+                estimate(320, 240, &standings(&cam, &places), person, Focal::Fov(50.0), &mut |_| 0.0).unwrap();
             assert_eq!(report.decided_by, "frames", "{report:?}");
             assert!((report.camera_height_m - h).abs() < 0.1, "{h} m: found {report:?}");
             assert!((report.tilt_deg - tilt).abs() < 3.0, "{tilt}°: found {report:?}");
@@ -428,8 +541,10 @@ mod tests {
         let body = Body::standard();
         let cam = camera(1.0, 10.0, 4.0, 45.0);
         let frames = standings(&cam, &[(0.3, 0.0)]);
-        let (found, report) = estimate(320, 240, &frames, Person::of(&body, false), Focal::Fov(45.0)).unwrap();
+        let (found, report) =
+            estimate(320, 240, &frames, Person::of(&body, false), Focal::Fov(45.0), &mut |_| 0.0).unwrap();
         assert_eq!(report.decided_by, "prior");
+        assert_eq!(report.probes.len(), 5, "{report:?}");
         let again = Standing::measure(&render_silhouette(&found, &body, &{
             let mut pose = Pose::rest(&body);
             pose.root.x = 0.3;
@@ -447,7 +562,7 @@ mod tests {
     #[test]
     fn an_empty_clip_has_no_camera() {
         assert_eq!(
-            estimate(320, 240, &[], Person::of(&Body::standard(), false), Focal::Assumed).unwrap_err(),
+            estimate(320, 240, &[], Person::of(&Body::standard(), false), Focal::Assumed, &mut |_| 0.0).unwrap_err(),
             AutoCameraError::NoStandingFrame
         );
     }

@@ -74,6 +74,20 @@ impl Root {
         Some(Root { position: DVec3::new(at.x, pelvis_height, at.z), heading })
     }
 
+    /// Whether the ray through the bottom of the person's regions in
+    /// `mask` points below the horizon, as it must for a person standing on
+    /// the floor before a camera above it; `true` for an empty mask.
+    pub fn feet_below_horizon(camera: &Camera, mask: &Mask) -> bool {
+        let person = person_region(mask);
+        let w = person.width();
+        let Some((bottom, row)) = person.pixels().chunks_exact(w).enumerate().rfind(|(_, r)| r.contains(&1)) else {
+            return true;
+        };
+        let columns: Vec<usize> = row.iter().enumerate().filter(|(_, p)| **p != 0).map(|(x, _)| x).collect();
+        let middle = columns[columns.len() / 2] as f64 + 0.5;
+        camera.ray(middle, bottom as f64 + 1.0).y < 0.0
+    }
+
     /// The pose with this root and joint-space vector `x`.
     pub fn pose(&self, x: &JointVector) -> Pose {
         Pose { root: self.position, heading: self.heading, x: *x }
