@@ -12,9 +12,11 @@
 //! every frame's head row best are the camera's. A person seen at several
 //! distances fixes both (the horizon is where their feet would vanish); a
 //! person standing in one place fixes only a curve of them (a higher camera
-//! tilted further down sees the same head and feet rows), and a weak prior
-//! on the camera's height picks the point of that curve. The summary says
-//! which decided.
+//! tilted further down sees the same head and feet rows): a weak prior on
+//! the camera's height picks a point of that curve, and other points
+//! compete with it by how well the tracker explains the frames through
+//! them (near the person the perspective differs along the curve). The
+//! summary says which decided.
 //!
 //! World frame of the estimate: the floor is y = 0, the camera stands at
 //! x = 0 on the +Z side looking towards −Z (a person at heading 0 faces
@@ -424,11 +426,13 @@ pub fn estimate(
     probes.extend(PROBE_HEIGHTS_M.iter().filter_map(|&hh| still.tilt_at(hh).map(|t| (hh, t))));
     let mut judged = Vec::new();
     for (hh, t) in probes {
-        let (camera, _) = geometry.camera(width, height, t, hh, focal, "", Vec::new())?;
-        judged.push(Probe { camera_height_m: hh, tilt_deg: t, score: judge(&camera) });
+        // A camera of the curve that keeps no frame is not one to judge.
+        if let Ok((camera, _)) = geometry.camera(width, height, t, hh, focal, "", Vec::new()) {
+            judged.push(Probe { camera_height_m: hh, tilt_deg: t, score: judge(&camera) });
+        }
     }
     // The prior's camera unless another explains the frames clearly better.
-    let prior = judged[0];
+    let prior = *judged.first().ok_or(AutoCameraError::NoCamera)?;
     let best = judged.iter().copied().fold(prior, |b, p| if p.score > b.score { p } else { b });
     let (chosen, decided_by) =
         if best.score > prior.score + MIN_PROBE_GAIN { (best, "likelihood") } else { (prior, "prior") };
