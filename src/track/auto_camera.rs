@@ -14,9 +14,9 @@
 //! person standing in one place fixes only a curve of them (a higher camera
 //! tilted further down sees the same head and feet rows): a weak prior on
 //! the camera's height picks a point of that curve, and other points
-//! compete with it by how well the tracker explains the frames through
-//! them (near the person the perspective differs along the curve). The
-//! summary says which decided.
+//! compete with it, when the person is near, by how well the tracker
+//! explains the frames through them (near the person the perspective
+//! differs along the curve). The summary says which decided.
 //!
 //! World frame of the estimate: the floor is y = 0, the camera stands at
 //! x = 0 on the +Z side looking towards −Z (a person at heading 0 faces
@@ -47,8 +47,15 @@ const ROW_NOISE_SHARE: f64 = 0.01;
 /// A frame whose head row misses by more than this many noise units is
 /// taken for one where something (a raised hand) stands above the head.
 const OUTLIER_UNITS: f64 = 3.0;
+/// Within this distance (meters) of a person standing still, the cameras
+/// that see their feet and head rows alike are compared by the tracker's
+/// likelihood: a camera 0.6 m higher or lower there changes how much nearer
+/// the head is than the feet by more than a tenth. Farther, the comparison
+/// is noise: on a person 4 m away it chose 1.7 m for a camera 1 m high
+/// and doubled the error.
+const NEAR_M: f64 = 3.0;
 /// The camera heights compared with the prior's choice when the person
-/// stands still, meters: the range people film from.
+/// stands still near the camera, meters: the range people film from.
 const PROBE_HEIGHTS_M: [f64; 4] = [0.8, 1.1, 1.7, 2.0];
 /// The mean log R per frame another camera of the curve must explain the
 /// frames better by than the prior's to be taken: where the perspective
@@ -166,10 +173,11 @@ pub struct CameraEstimate {
     /// How far the person's distance varied over the frames, meters.
     pub depth_range_m: f64,
     /// `frames` when the person's changing distance fixed the height and
-    /// tilt. When they stood still, the cameras that see them alike were
-    /// compared by how well the tracker explains the frames through each
-    /// (`probes`, the prior's first): `likelihood` when one did clearly
-    /// better than the prior's choice, else `prior`.
+    /// tilt. When they stood still within [`NEAR_M`], the cameras that see
+    /// them alike were compared by how well the tracker explains the
+    /// frames through each (`probes`, the prior's first): `likelihood` when
+    /// one did clearly better than the prior's choice; else, and farther
+    /// off, `prior`.
     pub decided_by: &'static str,
     pub probes: Vec<Probe>,
     /// Likelihood evaluations the comparison made (also counted in the
@@ -421,7 +429,12 @@ pub fn estimate(
     {
         return geometry.camera(width, height, tilt, h, focal, "frames", Vec::new());
     }
-    // Standing still: the curve's cameras at each probed height, judged.
+    // Standing still: far off, the curve's cameras see the person alike
+    // and the tracker cannot tell them apart; near, they are judged.
+    let (camera, report) = geometry.camera(width, height, tilt, h, focal, "prior", Vec::new())?;
+    if report.distance_m >= NEAR_M {
+        return Ok((camera, report));
+    }
     let mut probes = vec![(h, tilt)];
     probes.extend(PROBE_HEIGHTS_M.iter().filter_map(|&hh| still.tilt_at(hh).map(|t| (hh, t))));
     let mut judged = Vec::new();
@@ -547,8 +560,9 @@ mod tests {
         let frames = standings(&cam, &[(0.3, 0.0)]);
         let (found, report) =
             estimate(320, 240, &frames, Person::of(&body, false), Focal::Fov(45.0), &mut |_| 0.0).unwrap();
+        // 4 m away: the prior decides, and nothing is compared.
         assert_eq!(report.decided_by, "prior");
-        assert_eq!(report.probes.len(), 5, "{report:?}");
+        assert!(report.probes.is_empty(), "{report:?}");
         let again = Standing::measure(&render_silhouette(&found, &body, &{
             let mut pose = Pose::rest(&body);
             pose.root.x = 0.3;
