@@ -15,14 +15,7 @@
 #   SIZE=320x240 bash scripts/camera-trials.sh      # the same at 320×240
 #
 # Each row is the mean over seeds 1–3.
-set -euo pipefail
-cd "$(dirname "$0")/.."
-cargo build --release --quiet
-imitate="${CARGO_TARGET_DIR:-$PWD/target}/release/imitate"
-vocab="$PWD/vocab/default.vocab"
-work="${1:-$(mktemp -d)}"
-mkdir -p "$work"
-cd "$work"
+source "$(dirname "$0")/common.sh" "$@"
 seeds="1 2 3"
 export SIZE="${SIZE:-160x120}"
 

@@ -13,14 +13,7 @@
 #   bash scripts/person-trials.sh [WORK_DIR]        # about 3 minutes on 2 cores
 #
 # Every number is the mean over seeds 1–5 (min–max after it).
-set -euo pipefail
-cd "$(dirname "$0")/.."
-cargo build --release --quiet
-imitate="${CARGO_TARGET_DIR:-$PWD/target}/release/imitate"
-vocab="$PWD/vocab/default.vocab"
-work="${1:-$(mktemp -d)}"
-mkdir -p "$work"
-cd "$work"
+source "$(dirname "$0")/common.sh" "$@"
 seeds="1 2 3 4 5"
 bodies="capsules slight lanky average skirt broad heavy"
 

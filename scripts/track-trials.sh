@@ -8,14 +8,8 @@
 #   bash scripts/track-trials.sh [WORK_DIR]        # about 2.5 minutes on 2 cores; WORK_DIR may be reused
 #
 # Every number is the mean over seeds 1–5 (min–max after it).
-set -euo pipefail
-cd "$(dirname "$0")/.."
-cargo build --release --quiet
-imitate="${CARGO_TARGET_DIR:-$PWD/target}/release/imitate"
-real="${IMITATE_REAL_MOCAP:-$PWD/../shared/mocap/real}"
-work="${1:-$(mktemp -d)}"
-mkdir -p "$work"
-cd "$work"
+source "$(dirname "$0")/common.sh" "$@"
+real="${IMITATE_REAL_MOCAP:-$repo/../shared/mocap/real}"
 seeds="1 2 3 4 5"
 
 # Track FRAMES with VOCAB into runs named NAME_<seed>, score each against

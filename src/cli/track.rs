@@ -11,7 +11,7 @@ use imitate::mocap::pose::Motion;
 use imitate::mocap::pose::Pose;
 use imitate::track::auto_camera::{self, CameraEstimate, FOV_DEG, Focal, Person, Standing};
 use imitate::track::baseline::{AnnealParams, FullSpaceFilter, mean_training_pose};
-use imitate::track::calibrate::{CalibrationParams, CalibrationReport, HEIGHT_M, HeightFrom};
+use imitate::track::calibrate::{CalibrationParams, CalibrationReport, HEIGHT_M};
 use imitate::track::filter::FilterParams;
 use imitate::track::root::Root;
 use imitate::track::tracker::{FrameEstimate, Recognition, TrackParams, Tracker};
@@ -243,22 +243,15 @@ fn estimate_camera(
         (None, Some(px)) => Focal::Pixels(px),
         (None, None) => Focal::Assumed,
     };
-    let mut evaluations = 0;
-    let judge = &mut |camera: &Camera| {
-        let (score, spent) = auto_camera::explained(vocabulary, camera, pending, params);
-        evaluations += spent;
-        score
-    };
-    let found = auto_camera::estimate(width, height, &standings, person, focal, judge);
-    let (camera, mut estimate) = found.map_err(|e| {
+    let judge = &mut |camera: &Camera| auto_camera::explained(vocabulary, camera, pending, params);
+    auto_camera::estimate(width, height, &standings, person, focal, judge).map_err(|e| {
         UsageError(format!(
             "{}: {e} (looked at the first {} s of the person); pass --camera (a preset or a camera.json)",
             args.input.display(),
             window.give_up_s
         ))
-    })?;
-    estimate.evaluations = evaluations;
-    Ok((camera, estimate))
+        .into()
+    })
 }
 
 /// The header of `frames.csv`.
@@ -392,7 +385,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             // One camera cannot tell a tall person far away from a short
             // one near: the height the scene was scaled to is held.
             if args.height.is_none() {
-                params.calibration = params.calibration.map(|c| c.holding(height, HeightFrom::Camera));
+                params.calibration = params.calibration.map(|c| c.holding_camera_height(height));
             }
             let (camera, estimate) =
                 estimate_camera(&args, &mut silhouettes, &vocabulary, params, person, &mut pending)?;

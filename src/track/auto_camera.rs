@@ -390,16 +390,16 @@ impl Geometry<'_> {
 
 /// Estimates the camera of `width` × `height` frames from `frames` (whole
 /// silhouettes) of `person`. When the person stood still, the cameras of
-/// the curve that sees them alike are compared by `judge` (higher is
-/// better: how well the tracker explains the frames through each), the
-/// prior's choice among them first.
+/// the curve that sees them alike are compared by `judge` (how well the
+/// tracker explains the frames through each, higher better, and the
+/// likelihood evaluations that cost), the prior's choice among them first.
 pub fn estimate(
     width: usize,
     height: usize,
     frames: &[Standing],
     person: Person,
     focal: Focal,
-    judge: &mut dyn FnMut(&Camera) -> f64,
+    judge: &mut dyn FnMut(&Camera) -> (f64, u64),
 ) -> Result<(Camera, CameraEstimate), AutoCameraError> {
     if frames.is_empty() {
         return Err(AutoCameraError::NoStandingFrame);
@@ -437,11 +437,13 @@ pub fn estimate(
     }
     let mut probes = vec![(h, tilt)];
     probes.extend(PROBE_HEIGHTS_M.iter().filter_map(|&hh| still.tilt_at(hh).map(|t| (hh, t))));
-    let mut judged = Vec::new();
+    let (mut judged, mut evaluations) = (Vec::new(), 0);
     for (hh, t) in probes {
         // A camera of the curve that keeps no frame is not one to judge.
         if let Ok((camera, _)) = geometry.camera(width, height, t, hh, focal, "", Vec::new()) {
-            judged.push(Probe { camera_height_m: hh, tilt_deg: t, score: judge(&camera) });
+            let (score, spent) = judge(&camera);
+            evaluations += spent;
+            judged.push(Probe { camera_height_m: hh, tilt_deg: t, score });
         }
     }
     // The prior's camera unless another explains the frames clearly better.
@@ -449,7 +451,9 @@ pub fn estimate(
     let best = judged.iter().copied().fold(prior, |b, p| if p.score > b.score { p } else { b });
     let (chosen, decided_by) =
         if best.score > prior.score + MIN_PROBE_GAIN { (best, "likelihood") } else { (prior, "prior") };
-    geometry.camera(width, height, chosen.tilt_deg, chosen.camera_height_m, focal, decided_by, judged)
+    let (camera, report) =
+        geometry.camera(width, height, chosen.tilt_deg, chosen.camera_height_m, focal, decided_by, judged)?;
+    Ok((camera, CameraEstimate { evaluations, ..report }))
 }
 
 /// The `q` quantile of `values` (nearest rank); 0 when empty.
@@ -545,7 +549,7 @@ mod tests {
             let cam = camera(h, tilt, d, 50.0);
             let places: Vec<(f64, f64)> = (0..8).map(|k| (0.0, 1.5 - 0.4 * f64::from(k))).collect();
             let (found, report) =
-                estimate(320, 240, &standings(&cam, &places), person, Focal::Fov(50.0), &mut |_| 0.0).unwrap();
+                estimate(320, 240, &standings(&cam, &places), person, Focal::Fov(50.0), &mut |_| (0.0, 0)).unwrap();
             assert_eq!(report.decided_by, "frames", "{report:?}");
             assert!((report.camera_height_m - h).abs() < 0.1, "{h} m: found {report:?}");
             assert!((report.tilt_deg - tilt).abs() < 3.0, "{tilt}°: found {report:?}");
@@ -559,7 +563,7 @@ mod tests {
         let cam = camera(1.0, 10.0, 4.0, 45.0);
         let frames = standings(&cam, &[(0.3, 0.0)]);
         let (found, report) =
-            estimate(320, 240, &frames, Person::of(&body, false), Focal::Fov(45.0), &mut |_| 0.0).unwrap();
+            estimate(320, 240, &frames, Person::of(&body, false), Focal::Fov(45.0), &mut |_| (0.0, 0)).unwrap();
         // 4 m away: the prior decides, and nothing is compared.
         assert_eq!(report.decided_by, "prior");
         assert!(report.probes.is_empty(), "{report:?}");
@@ -580,7 +584,8 @@ mod tests {
     #[test]
     fn an_empty_clip_has_no_camera() {
         assert_eq!(
-            estimate(320, 240, &[], Person::of(&Body::standard(), false), Focal::Assumed, &mut |_| 0.0).unwrap_err(),
+            estimate(320, 240, &[], Person::of(&Body::standard(), false), Focal::Assumed, &mut |_| (0.0, 0))
+                .unwrap_err(),
             AutoCameraError::NoStandingFrame
         );
     }

@@ -67,11 +67,11 @@ pub struct CalibrationParams {
     pub refine_every_s: f64,
     /// How far a refinement moves the build towards its own fit.
     pub refine_rate: f64,
-    /// The person's standing height when held (told, or the one an
-    /// estimated camera scaled the scene to): then only the limbs' shares
-    /// and the girths are fitted.
-    pub height_m: Option<f64>,
-    pub height_from: HeightFrom,
+    /// The person's standing height (m) when held, and why (told, or the
+    /// one an estimated camera scaled the scene to; never
+    /// [`HeightFrom::Fit`]): then only the limbs' shares and the girths
+    /// are fitted.
+    pub held: Option<(f64, HeightFrom)>,
 }
 
 /// Where the drawn body's height comes from.
@@ -97,14 +97,23 @@ impl CalibrationParams {
             give_up_s: 10.0,
             refine_every_s: 6.0,
             refine_rate: 0.25,
-            height_m,
-            height_from: if height_m.is_some() { HeightFrom::Option } else { HeightFrom::Fit },
+            held: height_m.map(|h| (h, HeightFrom::Option)),
         }
     }
 
-    /// These settings with the height held at `height_m`, for `from`.
-    pub fn holding(self, height_m: f64, from: HeightFrom) -> CalibrationParams {
-        CalibrationParams { height_m: Some(height_m), height_from: from, ..self }
+    /// These settings with the height held at the `height_m` an estimated
+    /// camera scaled the scene to.
+    pub fn holding_camera_height(self, height_m: f64) -> CalibrationParams {
+        CalibrationParams { held: Some((height_m, HeightFrom::Camera)), ..self }
+    }
+
+    /// The held height, meters, if any.
+    pub fn held_height(&self) -> Option<f64> {
+        self.held.map(|(h, _)| h)
+    }
+
+    pub fn height_from(&self) -> HeightFrom {
+        self.held.map_or(HeightFrom::Fit, |(_, from)| from)
     }
 }
 

@@ -14,6 +14,9 @@ use rand_chacha::ChaCha8Rng;
 /// camera's).
 const TUNED_FPS: f64 = 15.0;
 
+/// Passes of [`Root::align`] when a filter is placed.
+const ALIGN_PASSES: usize = 2;
+
 /// Settings every primitive's filter shares.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct FilterParams {
@@ -187,22 +190,32 @@ impl<'v> Filter<'v> {
     }
 
     /// Chooses the heading (of `candidates`, each with its prior) and the
-    /// particle that best explain the first frame, then hill-climbs the
-    /// root with that particle's pose for `climb` steps.
+    /// particle that best explain the first frame, moves the root so that
+    /// the body drawn in that pose stands where the person does, then
+    /// hill-climbs the root with that pose for `climb` steps.
     pub fn place(&mut self, observation: &Observation, candidates: &[(f64, f64)], climb: usize) {
-        let mut best = (f64::MIN, f64::MIN, self.root, 0);
+        let mut best = (f64::MIN, self.root, 0);
         for &(heading, prior) in candidates {
             let root = Root { heading, ..self.root };
             for j in 0..self.params.particles {
                 let x = self.particle_pose(j);
                 let s = self.score(observation, &x, &root);
                 if s * prior > best.0 {
-                    best = (s * prior, s, root, j);
+                    best = (s * prior, root, j);
                 }
             }
         }
-        let (_, score, mut root, j) = best;
+        let (_, mut root, j) = best;
         let x = self.particle_pose(j);
+        // The silhouette's lowest row is the nearest toe, not the point
+        // under the pelvis: moved until the drawn body stands where the
+        // person does (a second pass settles the pixel it rounds to).
+        let (placed, camera) = (self.root.position, self.scorer.camera().clone());
+        for _ in 0..ALIGN_PASSES {
+            root.align(&camera, self.scorer.draw(&root.pose(&x)), placed);
+        }
+        self.evaluations += ALIGN_PASSES as u64;
+        let score = self.score(observation, &x, &root);
         let search = RootSearch { steps: climb, ..self.params.root };
         search.refine(&mut root, &x, score, observation, &mut self.scorer, &mut self.rng);
         self.evaluations += climb as u64;

@@ -41,11 +41,61 @@ impl Root {
     /// person is put at the distance of the camera's `look_at`. Seen from
     /// above, the lowest row is no longer the feet, and the ray through the
     /// silhouette's centre of mass meets the pelvis's height near the
-    /// pelvis. Only the silhouette's largest region counts. `None` for an
+    /// pelvis. Only the person's regions count. `None` for an
     /// empty silhouette.
     pub fn from_silhouette(camera: &Camera, mask: &Mask, pelvis_height: f64, heading: f64) -> Option<Root> {
-        // The person's own region: a speck below them would put their
-        // feet nearer the camera.
+        let Footprint { u, v, bottom } = Footprint::of(mask)?;
+        let origin = camera.position();
+        let look_at = DVec3::from_array(camera.spec().look_at);
+        let forward = (look_at - origin).normalize();
+        let meet = |ray: DVec3, height: f64| (ray.y < -1e-6).then(|| origin + ray * ((height - origin.y) / ray.y));
+        let ground = if forward.y < -std::f64::consts::FRAC_1_SQRT_2 {
+            meet(camera.ray(u, v), pelvis_height)
+        } else {
+            meet(camera.ray(u, bottom), 0.0)
+        };
+        let at = ground.unwrap_or_else(|| origin + camera.ray(u, bottom) * (look_at - origin).length());
+        Some(Root { position: DVec3::new(at.x, pelvis_height, at.z), heading })
+    }
+
+    /// Moves the root over the floor by how far the silhouette it draws,
+    /// `drawn`, is placed from `placed`, where [`Root::from_silhouette`]
+    /// put the observed one: both placements then err alike (the toes
+    /// standing in front of the pelvis, the row a pixel rounds to), so the
+    /// drawn body stands where the person does. Unmoved for an empty
+    /// `drawn`.
+    pub fn align(&mut self, camera: &Camera, drawn: &Mask, placed: DVec3) {
+        if let Some(at) = Root::from_silhouette(camera, drawn, self.position.y, self.heading) {
+            self.position += (placed - at.position).with_y(0.0);
+        }
+    }
+
+    /// Whether the ray through the bottom of the person's regions in
+    /// `mask` points below the horizon, as it must for a person standing on
+    /// the floor before a camera above it; `true` for an empty mask.
+    pub fn feet_below_horizon(camera: &Camera, mask: &Mask) -> bool {
+        Footprint::of(mask).is_none_or(|f| camera.ray(f.u, f.bottom).y < 0.0)
+    }
+
+    /// The pose with this root and joint-space vector `x`.
+    pub fn pose(&self, x: &JointVector) -> Pose {
+        Pose { root: self.position, heading: self.heading, x: *x }
+    }
+}
+
+/// Where the person's regions in a silhouette lie, in pixels.
+struct Footprint {
+    /// Their centre of mass.
+    u: f64,
+    v: f64,
+    /// The lower edge of their lowest row.
+    bottom: f64,
+}
+
+impl Footprint {
+    /// `None` for an empty silhouette. Only the person's regions count: a
+    /// speck below them would put their feet nearer the camera.
+    fn of(mask: &Mask) -> Option<Footprint> {
         let mask = &person_region(mask);
         let (mut count, mut sum_x, mut sum_y, mut bottom) = (0usize, 0usize, 0usize, 0usize);
         for (y, row) in mask.pixels().chunks_exact(mask.width()).enumerate() {
@@ -57,40 +107,11 @@ impl Root {
                 bottom = y;
             }
         }
-        if count == 0 {
-            return None;
-        }
-        let (u, v) = (sum_x as f64 / count as f64 + 0.5, sum_y as f64 / count as f64 + 0.5);
-        let origin = camera.position();
-        let look_at = DVec3::from_array(camera.spec().look_at);
-        let forward = (look_at - origin).normalize();
-        let meet = |ray: DVec3, height: f64| (ray.y < -1e-6).then(|| origin + ray * ((height - origin.y) / ray.y));
-        let ground = if forward.y < -std::f64::consts::FRAC_1_SQRT_2 {
-            meet(camera.ray(u, v), pelvis_height)
-        } else {
-            meet(camera.ray(u, bottom as f64 + 1.0), 0.0)
-        };
-        let at = ground.unwrap_or_else(|| origin + camera.ray(u, bottom as f64 + 1.0) * (look_at - origin).length());
-        Some(Root { position: DVec3::new(at.x, pelvis_height, at.z), heading })
-    }
-
-    /// Whether the ray through the bottom of the person's regions in
-    /// `mask` points below the horizon, as it must for a person standing on
-    /// the floor before a camera above it; `true` for an empty mask.
-    pub fn feet_below_horizon(camera: &Camera, mask: &Mask) -> bool {
-        let person = person_region(mask);
-        let w = person.width();
-        let Some((bottom, row)) = person.pixels().chunks_exact(w).enumerate().rfind(|(_, r)| r.contains(&1)) else {
-            return true;
-        };
-        let columns: Vec<usize> = row.iter().enumerate().filter(|(_, p)| **p != 0).map(|(x, _)| x).collect();
-        let middle = columns[columns.len() / 2] as f64 + 0.5;
-        camera.ray(middle, bottom as f64 + 1.0).y < 0.0
-    }
-
-    /// The pose with this root and joint-space vector `x`.
-    pub fn pose(&self, x: &JointVector) -> Pose {
-        Pose { root: self.position, heading: self.heading, x: *x }
+        (count > 0).then(|| Footprint {
+            u: sum_x as f64 / count as f64 + 0.5,
+            v: sum_y as f64 / count as f64 + 0.5,
+            bottom: bottom as f64 + 1.0,
+        })
     }
 }
 

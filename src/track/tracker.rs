@@ -114,7 +114,7 @@ impl<'v> Tracker<'v> {
         }
         // A held height is drawn from the first frame; a fitted one from
         // the first fit.
-        let physique = match params.calibration.and_then(|c| c.height_m) {
+        let physique = match params.calibration.and_then(|c| c.held_height()) {
             Some(h) => Physique { body: Body::of_shares(h, 1.0, 1.0), ..Physique::canonical() },
             None => Physique::canonical(),
         };
@@ -236,7 +236,7 @@ impl<'v> Tracker<'v> {
         let start = self.physique.clone();
         let samples = std::mem::take(&mut state.samples);
         state.next_s = state.seen_s;
-        let Some(fit) = calibrate::fit(&self.camera, &samples, &start, params.height_m, !first) else { return };
+        let Some(fit) = calibrate::fit(&self.camera, &samples, &start, params.held_height(), !first) else { return };
         let report = &mut state.report;
         report.evaluations += fit.evaluations;
         if first {
@@ -340,7 +340,7 @@ struct Calibrating {
 
 impl Calibrating {
     fn new(params: Option<CalibrationParams>, height_m: f64) -> Calibrating {
-        let mut report = CalibrationReport::canonical(params.map_or(HeightFrom::Fit, |p| p.height_from));
+        let mut report = CalibrationReport::canonical(params.map_or(HeightFrom::Fit, |p| p.height_from()));
         report.height_m = height_m;
         if params.is_none() {
             report.note = Some("calibration off: the canonical body was drawn throughout".into());
