@@ -6,6 +6,7 @@ pub mod color;
 pub mod distance;
 pub mod figure;
 pub mod frames;
+pub mod keypoints;
 pub mod mask;
 pub mod noise;
 pub mod render;
