@@ -23,6 +23,7 @@ use imitate::vision::mask::Mask;
 use imitate::vision::render::draw;
 use imitate::vision::scorer::Scorer;
 use imitate::vision::shape::capsules;
+use imitate::vision::sighting::Sighting;
 use imitate::vocab::corpus;
 use std::hint::black_box;
 use std::path::PathBuf;
@@ -66,9 +67,8 @@ fn vision(c: &mut Criterion) {
             b.iter(|| observation.likelihood(black_box(&drawn), &mut scratch))
         });
         let mut scorer = Scorer::new(camera.clone(), body.clone());
-        c.bench_function(&format!("likelihood/{size}"), |b| {
-            b.iter(|| scorer.score(&observation, black_box(&hypothesis)))
-        });
+        let sighting = Sighting::silhouette(observation.mask().clone());
+        c.bench_function(&format!("likelihood/{size}"), |b| b.iter(|| scorer.score(&sighting, black_box(&hypothesis))));
     }
 }
 

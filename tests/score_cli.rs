@@ -297,7 +297,15 @@ fn help_names_the_inputs_the_output_and_the_settle_window() {
     let out = imitate().args(["score", "--help"]).output().unwrap();
     assert!(out.status.success());
     let help = String::from_utf8(out.stdout).unwrap();
-    for word in ["RUN_DIR", "--truth <truth.csv>", "--output <metrics.json>", "--settle <S>", "[default: 0.5]"] {
+    let words = [
+        "RUN_DIR",
+        "--truth <truth.csv>",
+        "--keypoints <FILE>",
+        "--output <FILE.json>",
+        "--settle <S>",
+        "[default: 0.5]",
+    ];
+    for word in words {
         assert!(help.contains(word), "{word} missing from:\n{help}");
     }
 }

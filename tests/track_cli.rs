@@ -309,6 +309,101 @@ fn a_real_capture_is_tracked_with_the_shipped_vocabulary_within_150_mm_of_its_up
     assert!(error < 150.0, "upper body {error:.1} mm");
 }
 
+/// `frames.csv`-style keypoints of `video`'s true joints as its camera
+/// sees them, every other frame's wrists left out, in `dir/NAME`.
+fn true_keypoints(dir: &Path, video: &Path, name: &str) -> PathBuf {
+    use imitate::mocap::body::Joint;
+    let camera = imitate::vision::camera::Camera::read(&video.join("camera.json")).unwrap();
+    let truth = imitate::report::read_track(&video.join("truth.csv")).unwrap();
+    let sites = [
+        (Joint::LeftShoulder, "left_shoulder"),
+        (Joint::RightShoulder, "right_shoulder"),
+        (Joint::LeftElbow, "left_elbow"),
+        (Joint::RightElbow, "right_elbow"),
+        (Joint::LeftWrist, "left_wrist"),
+        (Joint::RightWrist, "right_wrist"),
+        (Joint::LeftHip, "left_hip"),
+        (Joint::RightHip, "right_hip"),
+        (Joint::LeftAnkle, "left_ankle"),
+        (Joint::RightAnkle, "right_ankle"),
+    ];
+    let mut csv = String::from("frame,joint,x,y,confidence\n");
+    for (k, joints) in truth.joints.iter().enumerate() {
+        for (joint, name) in sites {
+            let (u, v, _) = camera.project(joints[joint.index()]).unwrap();
+            let found = k % 2 == 0 || !name.ends_with("wrist");
+            csv += &if found { format!("{k},{name},{u:.2},{v:.2},0.9\n") } else { format!("{k},{name},,,0\n") };
+        }
+    }
+    fs::write(dir.join(name), csv).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn keypoints_alone_or_beside_the_silhouette_follow_the_person_closer_than_the_silhouette_alone() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let video = video(dir);
+    let keypoints = true_keypoints(dir, &video, "keypoints.csv");
+    let vocab = shipped("vocab/default.vocab");
+    let mut errors = Vec::new();
+    for observe in ["silhouette", "keypoints", "both"] {
+        let out = format!("run-{observe}");
+        let args = [
+            "track",
+            "video/frames",
+            "--vocab",
+            vocab.to_str().unwrap(),
+            "-o",
+            &out,
+            "--keypoints",
+            keypoints.to_str().unwrap(),
+            "--observe",
+            observe,
+            "--seed",
+            "1",
+        ];
+        ok(run(dir, &args, "2"));
+        let summary = summary_without_timing(&dir.join(&out));
+        assert_eq!(summary["observe"], observe);
+        assert_eq!(summary["keypoints"]["frames"], summary["frames"]);
+        errors.push(upper_body_mm(dir, &out, "video"));
+        // The projected joints agree with the keypoints they were tracked by.
+        ok(run(dir, &["score", &out, "--keypoints", keypoints.to_str().unwrap()], "2"));
+        let agreement: serde_json::Value =
+            serde_json::from_slice(&fs::read(dir.join(&out).join("agreement.json")).unwrap()).unwrap();
+        let pck = agreement["pck_mirror"].as_f64().unwrap();
+        eprintln!("{observe}: PCK@0.2 {pck:.3}");
+        assert!(pck >= 0.9, "{observe}: PCK@0.2 {pck}");
+    }
+    eprintln!("upper body: silhouette {:.1} mm, keypoints {:.1} mm, both {:.1} mm", errors[0], errors[1], errors[2]);
+    assert!(errors[1] < errors[0] && errors[2] < errors[0], "{errors:?}");
+    let both = ["score", "run-both", "--truth", "video/truth.csv", "--keypoints", keypoints.to_str().unwrap()];
+    assert_eq!(run(dir, &both, "2").status.code(), Some(2));
+    assert_eq!(run(dir, &["score", "run-both"], "2").status.code(), Some(2));
+}
+
+#[test]
+fn keypoints_that_cannot_be_used_are_refused_with_nothing_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    video(dir);
+    let vocab = shipped("vocab/default.vocab");
+    let vocab = vocab.to_str().unwrap();
+    let track = ["track", "video/frames", "--vocab", vocab, "-o", "out"];
+    let with = |extra: &[&'static str]| [&track[..], extra].concat();
+    refused(dir, &with(&["--observe", "keypoints"]), 2, "--keypoints FILE");
+    refused(dir, &with(&["--keypoints", "k.csv", "--baseline", "full-space"]), 2, "cannot be used with");
+    refused(dir, &with(&["--keypoints", "missing.csv"]), 1, "missing.csv");
+    fs::write(dir.join("broken.csv"), "frame,joint,x\n").unwrap();
+    refused(dir, &with(&["--keypoints", "broken.csv"]), 1, "no `y` column");
+    // Keypoints of a longer video.
+    let mut longer = fs::read_to_string(true_keypoints(dir, &dir.join("video"), "k.csv")).unwrap();
+    longer += "999,left_wrist,10,10,1\n";
+    fs::write(dir.join("longer.csv"), longer).unwrap();
+    refused(dir, &with(&["--keypoints", "longer.csv"]), 1, "keypoints of another video");
+}
+
 fn upper_body_mm(dir: &Path, run: &str, video: &str) -> f64 {
     let estimate = imitate::report::read_track(&dir.join(run).join("frames.csv")).unwrap();
     let truth = imitate::report::read_track(&dir.join(video).join("truth.csv")).unwrap();

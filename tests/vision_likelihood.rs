@@ -10,8 +10,8 @@ use imitate::mocap::body::{Body, Joint, Kind};
 use imitate::mocap::math::{exp_map, log_map};
 use imitate::mocap::pose::Pose;
 use imitate::vision::camera::{Camera, Preset};
-use imitate::vision::distance::Observation;
 use imitate::vision::scorer::Scorer;
+use imitate::vision::sighting::Sighting;
 use imitate::vocab::corpus;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -69,7 +69,7 @@ fn win_rate(corpus: &corpus::Corpus, preset: Preset, rng: &mut ChaCha8Rng) -> (f
                 out_of_view += 1;
                 continue;
             }
-            let observation = Observation::new(seen);
+            let observation = Sighting::silhouette(seen);
             let best = scorer.score(&observation, &truth);
             frames += 1;
             for (k, &j) in ARM.iter().enumerate() {

@@ -3,29 +3,42 @@
 use super::{Global, Outcome, UsageError, note};
 use anyhow::Context;
 use imitate::fsutil::write_atomic;
+use imitate::report::agreement::agreement;
 use imitate::report::metrics::{Metrics, score};
 use imitate::report::{read_primitives, read_track};
+use imitate::vision::camera::Camera;
+use imitate::vision::keypoints::Keypoints;
 use std::io::Write;
 use std::path::PathBuf;
 
 /// Score a tracking run against the ground truth of its video: joint
 /// position errors (mm), limb direction errors (degrees), how often the
 /// named activity is the true one, and how soon a switch of activity is
-/// recognized.
+/// recognized. Or, with --keypoints, its 2-D agreement with a detector's
+/// keypoints of the same frames (PCK).
 ///
 /// Reads RUN_DIR/frames.csv and RUN_DIR/summary.json (as `imitate track`
 /// writes them) and the truth.csv `imitate render` wrote with the video,
-/// matched row by row; writes metrics.json (see docs/formats.md).
+/// matched row by row; writes metrics.json (see docs/formats.md). With
+/// --keypoints, reads RUN_DIR/camera.json too and writes agreement.json.
 #[derive(Debug, clap::Args)]
+#[command(group(clap::ArgGroup::new("against").required(true).args(["truth", "keypoints"])))]
 pub struct Args {
     /// The tracking run's folder.
     #[arg(value_name = "RUN_DIR")]
     pub run: PathBuf,
     /// The video's ground truth, as `imitate render` writes it.
     #[arg(long, value_name = "truth.csv")]
-    pub truth: PathBuf,
-    /// Where to write the metrics [default: RUN_DIR/metrics.json].
-    #[arg(short, long, value_name = "metrics.json")]
+    pub truth: Option<PathBuf>,
+    /// Reference keypoints of the same frames (any form `track
+    /// --keypoints` reads, e.g. `scripts/keypoints.sh`'s MediaPipe CSV):
+    /// the share of shoulders, elbows, wrists and hips within 0.2 torso
+    /// lengths of them.
+    #[arg(long, value_name = "FILE")]
+    pub keypoints: Option<PathBuf>,
+    /// Where to write the metrics [default: RUN_DIR/metrics.json, or
+    /// RUN_DIR/agreement.json with --keypoints].
+    #[arg(short, long, value_name = "FILE.json")]
     pub output: Option<PathBuf>,
     /// Seconds after each switch of the true activity that the settled
     /// accuracy leaves out, while the tracker catches up.
@@ -33,19 +46,45 @@ pub struct Args {
     pub settle: f64,
 }
 
+/// The share of the reference's torso within which a point agrees.
+const PCK_THRESHOLD: f64 = 0.2;
+
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     if !(args.settle.is_finite() && args.settle >= 0.0) {
         return Err(UsageError(format!("--settle {}: must be a number of seconds, 0 or more", args.settle)).into());
     }
-    let truth = read_track(&args.truth)?;
     let estimate = read_track(&args.run.join("frames.csv"))?;
-    let primitives = read_primitives(&args.run.join("summary.json"))?;
-    let metrics = score(&estimate, &truth, &primitives, args.settle)?;
-    let output = args.output.unwrap_or_else(|| args.run.join("metrics.json"));
-    let json = serde_json::to_string_pretty(&metrics).expect("metrics are plain numbers and maps") + "\n";
+    let (json, output, line) = match (&args.truth, &args.keypoints) {
+        (Some(truth), _) => {
+            let truth = read_track(truth)?;
+            let primitives = read_primitives(&args.run.join("summary.json"))?;
+            let metrics = score(&estimate, &truth, &primitives, args.settle)?;
+            let output = args.output.clone().unwrap_or_else(|| args.run.join("metrics.json"));
+            let line = summary(&metrics, &output.display().to_string());
+            (serde_json::to_string_pretty(&metrics), output, line)
+        }
+        (None, keypoints) => {
+            let keypoints = keypoints.as_ref().ok_or_else(|| UsageError("give --truth or --keypoints".into()))?;
+            let camera = Camera::read(&args.run.join("camera.json"))?;
+            let mut reference = Keypoints::read(keypoints)?;
+            reference.fit_to(camera.width(), camera.height())?;
+            let agreement = agreement(&estimate, &camera, &reference, PCK_THRESHOLD)?;
+            let output = args.output.clone().unwrap_or_else(|| args.run.join("agreement.json"));
+            let line = format!(
+                "{} frames, {} points: PCK@{PCK_THRESHOLD} {:.3} ({:.3} with left and right swapped where that agrees better) → {}",
+                agreement.frames,
+                agreement.points,
+                agreement.pck,
+                agreement.pck_mirror,
+                output.display()
+            );
+            (serde_json::to_string_pretty(&agreement), output, line)
+        }
+    };
+    let json = json.expect("metrics are plain numbers and maps") + "\n";
     write_atomic(&output, |w| w.write_all(json.as_bytes()))
         .with_context(|| format!("{}: cannot write", output.display()))?;
-    note(global, &summary(&metrics, &output.display().to_string()));
+    note(global, &line);
     Ok(Outcome::Success)
 }
 

@@ -17,6 +17,7 @@ use imitate::track::root::Root;
 use imitate::track::tracker::{FrameEstimate, Recognition, TrackParams, Tracker};
 use imitate::vision::camera::Camera;
 use imitate::vision::frames::{Expect, FrameSource, beside_frames, video_frame_rate};
+use imitate::vision::keypoints::{Keypoints, SitePoints};
 use imitate::vision::mask::Mask;
 use imitate::vision::silhouette::Silhouettes;
 use imitate::vision::truth;
@@ -101,6 +102,17 @@ pub struct Args {
     /// name no activity.
     #[arg(long, value_enum)]
     pub baseline: Option<Baseline>,
+    /// 2-D keypoints of the same frames from a pose detector: a CSV or
+    /// JSON file (MediaPipe's landmarks, as `scripts/keypoints.sh` writes
+    /// them, or COCO-17 results) or a folder of OpenPose BODY_25 / COCO
+    /// files (see docs/formats.md, "Keypoints").
+    #[arg(long, value_name = "FILE", conflicts_with = "baseline")]
+    pub keypoints: Option<PathBuf>,
+    /// What the filters score each frame by: the silhouette, the
+    /// keypoints, or both. Default: both with --keypoints, else the
+    /// silhouette.
+    #[arg(long, value_enum)]
+    pub observe: Option<Observe>,
     /// Replace the output folder if it exists.
     #[arg(long)]
     pub force: bool,
@@ -111,6 +123,20 @@ pub enum Baseline {
     FullSpace,
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Observe {
+    Silhouette,
+    Keypoints,
+    Both,
+}
+
+impl Observe {
+    fn silhouette(self) -> bool {
+        self != Observe::Keypoints
+    }
+}
+
 /// What follows the person: the primitives' filters, or the baseline.
 enum Follower<'v> {
     Primitives(Box<Tracker<'v>>),
@@ -119,10 +145,10 @@ enum Follower<'v> {
 
 impl Follower<'_> {
     /// The frame's pose, and the primitives' view of it when they track.
-    fn step(&mut self, mask: &Mask) -> (Pose, Option<FrameEstimate>) {
+    fn step(&mut self, mask: &Mask, keypoints: Option<&SitePoints>) -> (Pose, Option<FrameEstimate>) {
         match self {
             Follower::Primitives(tracker) => {
-                let estimate = tracker.step(mask);
+                let estimate = tracker.step_seen(Some(mask), keypoints);
                 (estimate.pose, Some(estimate))
             }
             Follower::FullSpace(filter) => (filter.step(mask), None),
@@ -181,6 +207,9 @@ fn params(args: &Args, fps: f64) -> Result<TrackParams, UsageError> {
         && !(focal.is_finite() && focal > 0.0)
     {
         return Err(UsageError(format!("--focal {focal}: a focal length is a positive number of pixels")));
+    }
+    if args.keypoints.is_none() && args.observe.is_some_and(|o| o != Observe::Silhouette) {
+        return Err(UsageError("--observe keypoints or both: give the keypoints with --keypoints FILE".into()));
     }
     let recognition = if args.feedback { Recognition::FEEDBACK } else { Recognition::Likelihood };
     let filter = FilterParams::standard(args.particles, args.lookahead, 1.0 / fps);
@@ -373,6 +402,25 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let (fps, rate_from) = frame_rate(&args, &source)?;
     let mut params = params(&args, fps)?;
     let mut given = given_camera(&args, &source)?;
+    let observe = args.observe.unwrap_or(if args.keypoints.is_some() { Observe::Both } else { Observe::Silhouette });
+    let (keypoints, keypoints_report) = match &args.keypoints {
+        Some(path) => {
+            let mut keypoints = Keypoints::read(path)?;
+            let outside = keypoints.fit_to(source.width(), source.height())?;
+            let report = serde_json::json!({
+                "path": path.display().to_string(),
+                "layout": keypoints.layout.map(|l| l.name()),
+                "frames": keypoints.frames.len(),
+                "points_dropped": keypoints.dropped,
+                "points_outside_frames": outside,
+            });
+            (Some(keypoints), Some(report))
+        }
+        None => (None, None),
+    };
+    let keypoints_of = |k: usize| {
+        keypoints.as_ref().and_then(|kp| kp.frames.get(k)).filter(|points| points.iter().any(Option::is_some))
+    };
     // The timing includes estimating the camera.
     let started = Instant::now();
     let mut silhouettes = Silhouettes::new(&args.input, source, args.background.clone());
@@ -430,8 +478,12 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
                 args.input.display()
             );
         }
-        let (pose, estimate) = follower.step(&mask);
-        coasted += usize::from(mask.count() == 0);
+        if !observe.silhouette() {
+            mask.clear();
+        }
+        let seen = if observe == Observe::Silhouette { None } else { keypoints_of(k) };
+        let (pose, estimate) = follower.step(&mask, seen);
+        coasted += usize::from(mask.count() == 0 && seen.is_none());
         rows.push(row(k, k as f64 / fps, &names, &pose, estimate.as_ref(), follower.body()));
         if let Some(e) = &estimate {
             likelihood_rows.push(likelihood_row(k, e));
@@ -443,6 +495,9 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     bar.finish_and_clear();
     if k == 0 {
         bail!("{}: no frames", args.input.display());
+    }
+    if let Some(keypoints) = &keypoints {
+        keypoints.check_frames(k)?;
     }
     let seconds = started.elapsed().as_secs_f64();
     let evaluations = follower.evaluations() + camera_estimate.as_ref().map_or(0, |e| e.evaluations);
@@ -461,6 +516,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         "body": follower.calibration(),
         "background": silhouettes.background_used(),
         "settings": params,
+        "observe": observe,
+        "keypoints": keypoints_report,
         "baseline": args.baseline.map(|_| serde_json::json!({ "kind": "full_space", "settings": anneal })),
         "seed": args.seed,
         "fps": fps,
@@ -504,7 +561,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     note(
         global,
         &format!(
-            "{}: {k} frames ({coasted} without a silhouette), {who} → {output} in {seconds:.2} s ({:.1} frames/s, {:.0} likelihoods/frame)",
+            "{}: {k} frames ({coasted} without a silhouette or keypoints), {who} → {output} in {seconds:.2} s ({:.1} frames/s, {:.0} likelihoods/frame)",
             args.input.display(),
             k as f64 / seconds,
             evaluations as f64 / k as f64

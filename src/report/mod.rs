@@ -2,6 +2,7 @@
 //! run's `frames.csv` and `summary.json` and a render's `truth.csv` (here),
 //! and the scores themselves ([`metrics`]).
 
+pub mod agreement;
 pub mod corpora;
 pub mod eval;
 pub mod figures;

@@ -10,9 +10,9 @@ use crate::mocap::pose::Pose;
 use crate::track::filter::systematic;
 use crate::track::root::Root;
 use crate::vision::camera::Camera;
-use crate::vision::distance::Observation;
 use crate::vision::mask::Mask;
 use crate::vision::scorer::Scorer;
+use crate::vision::sighting::Sighting;
 use crate::vocab::vocabulary::Vocabulary;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -128,11 +128,11 @@ impl FullSpaceFilter {
         if self.particles.is_empty() {
             self.place(silhouette);
         }
-        let observation = Observation::new(silhouette.clone());
+        let sighting = Sighting::silhouette(silhouette.clone());
         let mut scale = 1.0;
         for _ in 0..self.params.layers {
             self.diffuse(scale);
-            let scores = self.score(&observation);
+            let scores = self.score(&sighting);
             let weights = self.anneal(&scores);
             self.estimate = self.mean(&weights);
             self.particles = systematic(&weights, &mut self.rng).map(|j| self.particles[j]).collect();
@@ -169,13 +169,13 @@ impl FullSpaceFilter {
     /// of the particles per kept scorer, since a scorer's drawing buffers
     /// cost more to build than a score. The draws stay serial, so threads
     /// cannot change results.
-    fn score(&mut self, observation: &Observation) -> Vec<f64> {
+    fn score(&mut self, sighting: &Sighting) -> Vec<f64> {
         self.evaluations += self.particles.len() as u64;
         let share = self.particles.len().div_ceil(self.scorers.len());
         let mut scores = vec![0.0; self.particles.len()];
         scores.par_chunks_mut(share).zip(self.particles.par_chunks(share)).zip(self.scorers.par_iter_mut()).for_each(
             |((out, poses), scorer)| {
-                out.iter_mut().zip(poses).for_each(|(s, pose)| *s = scorer.score(observation, pose));
+                out.iter_mut().zip(poses).for_each(|(s, pose)| *s = scorer.score(sighting, pose));
             },
         );
         scores

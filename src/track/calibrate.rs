@@ -16,10 +16,10 @@
 use crate::mocap::body::{Body, Joint};
 use crate::mocap::pose::Pose;
 use crate::vision::camera::Camera;
-use crate::vision::distance::Observation;
 use crate::vision::mask::Mask;
 use crate::vision::scorer::Scorer;
 use crate::vision::shape::Girth;
+use crate::vision::sighting::Sighting;
 use crate::vision::silhouette::person_region;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -174,7 +174,7 @@ pub fn blend(from: &Physique, to: &Physique, rate: f64) -> Physique {
 /// A frame the fit looks at: its silhouette and the pose tracked in it.
 #[derive(Clone, Debug)]
 pub struct Sample {
-    pub observation: Observation,
+    pub sighting: Sighting,
     pub pose: Pose,
 }
 
@@ -366,7 +366,7 @@ fn placed(scorer: &mut Scorer, camera: &Camera, sample: &Sample, start: &Physiqu
     let mut at = |offset: f64| {
         let mut pose = sample.pose;
         pose.root = root + away * offset;
-        (scorer.score(&sample.observation, &pose), pose)
+        (scorer.score(&sample.sighting, &pose), pose)
     };
     // Golden-section search for the best offset.
     let phi = (5f64.sqrt() - 1.0) / 2.0;
@@ -441,7 +441,7 @@ mod tests {
                 // the canonical pelvis height.
                 let mut canonical = pose;
                 canonical.root.y *= Body::standard().pelvis_height() / motion.body.pelvis_height();
-                Sample { observation: Observation::new(mask), pose: canonical }
+                Sample { sighting: Sighting::silhouette(mask), pose: canonical }
             })
             .collect()
     }

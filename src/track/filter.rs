@@ -4,8 +4,8 @@ use crate::mocap::body::JointVector;
 use crate::track::calibrate::Physique;
 use crate::track::cone::{Cone, ConeScratch};
 use crate::track::root::{Root, RootSearch};
-use crate::vision::distance::Observation;
 use crate::vision::scorer::Scorer;
+use crate::vision::sighting::Sighting;
 use crate::vocab::primitive::Primitive;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -184,22 +184,22 @@ impl<'v> Filter<'v> {
         self.primitive.reconstruct(&self.particles[j * d..(j + 1) * d])
     }
 
-    fn score(&mut self, observation: &Observation, x: &JointVector, root: &Root) -> f64 {
+    fn score(&mut self, sighting: &Sighting, x: &JointVector, root: &Root) -> f64 {
         self.evaluations += 1;
-        self.scorer.score(observation, &root.pose(x))
+        self.scorer.score(sighting, &root.pose(x))
     }
 
     /// Chooses the heading (of `candidates`, each with its prior) and the
     /// particle that best explain the first frame, moves the root so that
     /// the body drawn in that pose stands where the person does, then
     /// hill-climbs the root with that pose for `climb` steps.
-    pub fn place(&mut self, observation: &Observation, candidates: &[(f64, f64)], climb: usize) {
+    pub fn place(&mut self, sighting: &Sighting, candidates: &[(f64, f64)], climb: usize) {
         let mut best = (f64::MIN, self.root, 0);
         for &(heading, prior) in candidates {
             let root = Root { heading, ..self.root };
             for j in 0..self.params.particles {
                 let x = self.particle_pose(j);
-                let s = self.score(observation, &x, &root);
+                let s = self.score(sighting, &x, &root);
                 if s * prior > best.0 {
                     best = (s * prior, root, j);
                 }
@@ -207,29 +207,32 @@ impl<'v> Filter<'v> {
         }
         let (_, mut root, j) = best;
         let x = self.particle_pose(j);
-        // The silhouette's lowest row is the nearest toe, not the point
-        // under the pelvis: moved until the drawn body stands where the
-        // person does (a second pass settles the pixel it rounds to).
-        let (placed, camera) = (self.root.position, self.scorer.camera().clone());
-        for _ in 0..ALIGN_PASSES {
-            root.align(&camera, self.scorer.draw(&root.pose(&x)), placed);
+        // Placed from a silhouette, the lowest row is the nearest toe, not
+        // the point under the pelvis: moved until the drawn body stands
+        // where the person does (a second pass settles the pixel it
+        // rounds to).
+        if sighting.mask().is_some() {
+            let (placed, camera) = (self.root.position, self.scorer.camera().clone());
+            for _ in 0..ALIGN_PASSES {
+                root.align(&camera, self.scorer.draw(&root.pose(&x)), placed);
+            }
+            self.evaluations += ALIGN_PASSES as u64;
         }
-        self.evaluations += ALIGN_PASSES as u64;
-        let score = self.score(observation, &x, &root);
+        let score = self.score(sighting, &x, &root);
         let search = RootSearch { steps: climb, ..self.params.root };
-        search.refine(&mut root, &x, score, observation, &mut self.scorer, &mut self.rng);
+        search.refine(&mut root, &x, score, sighting, &mut self.scorer, &mut self.rng);
         self.evaluations += climb as u64;
         self.root = root;
     }
 
     /// One frame: every particle moves through the bending cone (or a few
-    /// are renewed from the training poses); with an
-    /// observation it is weighted by its likelihood, the estimate is the
+    /// are renewed from the training poses); with a
+    /// sighting it is weighted by its likelihood, the estimate is the
     /// better of the weighted mean and the best particle, the root is
     /// refined for it, and the particles are resampled. Without one (an
     /// empty silhouette) the filter coasts: the particles move and the
     /// estimate is their mean.
-    pub fn step(&mut self, observation: Option<&Observation>) -> Estimate {
+    pub fn step(&mut self, sighting: Option<&Sighting>) -> Estimate {
         let (d, n) = (self.primitive.dims(), self.params.particles);
         let step = self.step_length();
         let field = self.primitive.field();
@@ -242,7 +245,7 @@ impl<'v> Filter<'v> {
                 self.params.cone.sample(self.primitive, step, y, &mut self.rng, &mut self.cone);
             }
         }
-        let Some(observation) = observation else {
+        let Some(sighting) = sighting else {
             self.weights.fill(1.0 / n as f64);
             let latent = self.mean();
             let x = self.primitive.reconstruct(&latent);
@@ -252,7 +255,7 @@ impl<'v> Filter<'v> {
         let mut scores = vec![0.0; n];
         for (j, s) in scores.iter_mut().enumerate() {
             let x = self.particle_pose(j);
-            *s = self.score(observation, &x, &root);
+            *s = self.score(sighting, &x, &root);
         }
         // Weights relative to the best score, so the power cannot underflow all.
         let top = scores.iter().copied().fold(f64::MIN, f64::max);
@@ -269,14 +272,14 @@ impl<'v> Filter<'v> {
         let best = (0..n).fold(0, |b, j| if self.weights[j] > self.weights[b] { j } else { b });
         let mean = self.mean();
         let mean_x = self.primitive.reconstruct(&mean);
-        let mean_score = self.score(observation, &mean_x, &root);
+        let mean_score = self.score(sighting, &mean_x, &root);
         let (latent, x, score) = if mean_score >= scores[best] {
             (mean, mean_x, mean_score)
         } else {
             (self.particles[best * d..(best + 1) * d].to_vec(), self.particle_pose(best), scores[best])
         };
         let mut root = self.root;
-        let score = self.params.root.refine(&mut root, &x, score, observation, &mut self.scorer, &mut self.rng);
+        let score = self.params.root.refine(&mut root, &x, score, sighting, &mut self.scorer, &mut self.rng);
         self.evaluations += self.params.root.steps as u64;
         self.root = root;
         self.resample();

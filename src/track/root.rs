@@ -3,12 +3,13 @@
 //! silhouette, then refined by Gaussian steps kept only when the
 //! likelihood rises.
 
-use crate::mocap::body::JointVector;
+use crate::mocap::body::{Body, Joint, JointVector};
 use crate::mocap::pose::Pose;
 use crate::vision::camera::Camera;
-use crate::vision::distance::Observation;
+use crate::vision::keypoints::{Site, SitePoints};
 use crate::vision::mask::Mask;
 use crate::vision::scorer::Scorer;
+use crate::vision::sighting::Sighting;
 use crate::vision::silhouette::person_region;
 use glam::DVec3;
 use rand::Rng;
@@ -56,6 +57,31 @@ impl Root {
         };
         let at = ground.unwrap_or_else(|| origin + camera.ray(u, bottom) * (look_at - origin).length());
         Some(Root { position: DVec3::new(at.x, pelvis_height, at.z), heading })
+    }
+
+    /// Where a standing person's pelvis is, from their keypoints: the ray
+    /// through the ankles' midpoint meets the height the ankles have at
+    /// rest, or without ankles the ray through the hips' midpoint meets
+    /// the hips'. `None` without either, or where the ray misses.
+    pub fn from_keypoints(camera: &Camera, points: &SitePoints, body: &Body) -> Option<Root> {
+        let rest = body.forward(&Pose::rest(body));
+        let middle = |a: Site, b: Site| {
+            let seen: Vec<_> = [a, b].iter().filter_map(|s| points[s.index()]).collect();
+            (!seen.is_empty()).then(|| {
+                let n = seen.len() as f64;
+                (seen.iter().map(|k| k.x).sum::<f64>() / n, seen.iter().map(|k| k.y).sum::<f64>() / n)
+            })
+        };
+        let ((u, v), height) = match middle(Site::LeftAnkle, Site::RightAnkle) {
+            Some(at) => (at, rest.position(Joint::LeftAnkle).y),
+            None => (middle(Site::LeftHip, Site::RightHip)?, rest.position(Joint::LeftHip).y),
+        };
+        let (origin, ray) = (camera.position(), camera.ray(u, v));
+        let along = (height - origin.y) / ray.y;
+        (along.is_finite() && along > 0.0).then(|| {
+            let at = origin + ray * along;
+            Root { position: DVec3::new(at.x, body.pelvis_height(), at.z), heading: 0.0 }
+        })
     }
 
     /// Moves the root over the floor by how far the silhouette it draws,
@@ -124,7 +150,7 @@ impl RootSearch {
         root: &mut Root,
         x: &JointVector,
         mut score: f64,
-        observation: &Observation,
+        sighting: &Sighting,
         scorer: &mut Scorer,
         rng: &mut impl Rng,
     ) -> f64 {
@@ -134,7 +160,7 @@ impl RootSearch {
                 position: root.position + DVec3::new(gauss(), gauss(), gauss()) * self.move_m,
                 heading: root.heading + gauss() * self.turn_rad,
             };
-            let s = scorer.score(observation, &candidate.pose(x));
+            let s = scorer.score(sighting, &candidate.pose(x));
             if s > score {
                 (*root, score) = (candidate, s);
             }

@@ -8,9 +8,10 @@ use crate::track::calibrate::{self, CalibrationParams, CalibrationReport, Height
 use crate::track::filter::{Estimate, Filter, FilterParams};
 use crate::track::root::Root;
 use crate::vision::camera::Camera;
-use crate::vision::distance::Observation;
+use crate::vision::keypoints::SitePoints;
 use crate::vision::mask::Mask;
 use crate::vision::scorer::Scorer;
+use crate::vision::sighting::{KEYPOINT_SIGMA_TORSO_SHARE, KeypointTarget, Sighting};
 use crate::vocab::vocabulary::Vocabulary;
 use glam::DVec3;
 use rand::SeedableRng;
@@ -98,6 +99,8 @@ pub struct Tracker<'v> {
     history: Vec<f64>,
     placed: bool,
     winner: usize,
+    /// The person's torso in the last keypoints that showed it, pixels.
+    torso_px: Option<f64>,
 }
 
 impl<'v> Tracker<'v> {
@@ -142,6 +145,7 @@ impl<'v> Tracker<'v> {
             history: vec![1.0 / n as f64; n],
             placed: false,
             winner: 0,
+            torso_px: None,
         })
     }
 
@@ -163,12 +167,20 @@ impl<'v> Tracker<'v> {
 
     /// Tracks one frame's silhouette (the camera's size).
     pub fn step(&mut self, silhouette: &Mask) -> FrameEstimate {
-        let observation = (silhouette.count() > 0).then(|| Observation::new(silhouette.clone()));
-        if let (false, Some(observation)) = (self.placed, &observation) {
-            self.place(silhouette, observation);
+        self.step_seen(Some(silhouette), None)
+    }
+
+    /// Tracks one frame from what it shows: its silhouette (the camera's
+    /// size; `None` where not observed) and a detector's keypoints (pixels
+    /// of the camera's frames). With neither, the filters coast.
+    pub fn step_seen(&mut self, silhouette: Option<&Mask>, keypoints: Option<&SitePoints>) -> FrameEstimate {
+        let target = keypoints.and_then(|k| self.keypoint_target(k));
+        let sighting = Sighting::of(silhouette, target);
+        if let (false, Some(sighting)) = (self.placed, &sighting) {
+            self.place(sighting);
         }
-        let estimates: Vec<Estimate> = self.filters.par_iter_mut().map(|f| f.step(observation.as_ref())).collect();
-        let probabilities = match observation {
+        let estimates: Vec<Estimate> = self.filters.par_iter_mut().map(|f| f.step(sighting.as_ref())).collect();
+        let probabilities = match sighting {
             Some(_) => Some(self.recognize(&estimates)),
             None => {
                 self.forget();
@@ -186,25 +198,37 @@ impl<'v> Tracker<'v> {
         }
         let chosen = &estimates[self.winner];
         let pose = chosen.root.pose(&chosen.x);
-        if let Some(observation) = observation
+        if let Some(sighting) = sighting
             && self.placed
         {
-            self.calibrate(silhouette, observation, pose);
+            self.calibrate(sighting, pose);
         }
         FrameEstimate { estimates, probabilities, winner: self.winner, pose }
+    }
+
+    /// The keypoints as the filters score them: a detector's error is a
+    /// share of the person's torso (this frame's, else the last one seen),
+    /// widened by the square root of the filters' sharpness, which their
+    /// weights raise each score to. `None` before any torso was seen.
+    fn keypoint_target(&mut self, points: &SitePoints) -> Option<KeypointTarget> {
+        if let Some(torso) = KeypointTarget::torso_px(points) {
+            self.torso_px = Some(torso);
+        }
+        let sigma = KEYPOINT_SIGMA_TORSO_SHARE * self.torso_px? * self.params.filter.sharpness.sqrt();
+        KeypointTarget::new(*points, sigma)
     }
 
     /// Collects the frame for calibration and fits the body when a window
     /// is full: the first fit from the canonical body, later ones a step
     /// of the way from the current build towards their own.
-    fn calibrate(&mut self, silhouette: &Mask, observation: Observation, pose: Pose) {
+    fn calibrate(&mut self, sighting: Sighting, pose: Pose) {
         let Some(params) = self.params.calibration else { return };
         let dt = self.params.filter.frame_time_s;
         let state = &mut self.calibration;
         state.seen_s += dt;
         let window = (params.window_s / dt).round().max(1.0) as usize;
-        if calibrate::whole(silhouette) {
-            state.samples.push(Sample { observation, pose });
+        if sighting.mask().is_some_and(calibrate::whole) {
+            state.samples.push(Sample { sighting, pose });
             if state.samples.len() > window {
                 state.samples.remove(0);
             }
@@ -276,12 +300,15 @@ impl<'v> Tracker<'v> {
         self.physique = physique;
     }
 
-    /// Puts every filter's root on the person the first time one shows.
-    fn place(&mut self, silhouette: &Mask, observation: &Observation) {
-        let Some(root) = Root::from_silhouette(&self.camera, silhouette, self.physique.body.pelvis_height(), 0.0)
-        else {
-            return;
+    /// Puts every filter's root on the person the first time one shows:
+    /// under their silhouette, or else their keypoints.
+    fn place(&mut self, sighting: &Sighting) {
+        let body = &self.physique.body;
+        let root = match sighting.mask() {
+            Some(mask) => Root::from_silhouette(&self.camera, mask, body.pelvis_height(), 0.0),
+            None => sighting.keypoints().and_then(|k| Root::from_keypoints(&self.camera, k.points(), body)),
         };
+        let Some(root) = root else { return };
         // A silhouette looks the same from the front as from the back, so
         // a prior breaks the tie: people mostly face the camera. Turned
         // away, a heading keeps half its score; at right angles, three
@@ -294,7 +321,7 @@ impl<'v> Tracker<'v> {
             .collect();
         self.filters.par_iter_mut().for_each(|f| {
             f.set_root(root);
-            f.place(observation, &headings, PLACEMENT_STEPS);
+            f.place(sighting, &headings, PLACEMENT_STEPS);
         });
         self.placed = true;
     }

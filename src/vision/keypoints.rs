@@ -75,7 +75,8 @@ impl Site {
         Some(site)
     }
 
-    fn index(self) -> usize {
+    /// Its place in [`SitePoints`].
+    pub fn index(self) -> usize {
         self as usize
     }
 }
@@ -190,6 +191,10 @@ pub struct Keypoints {
     /// Points dropped on reading: coordinates not finite, or a
     /// confidence of zero.
     pub dropped: usize,
+    /// Whether every frame is listed (JSON documents, OpenPose folders);
+    /// a CSV or COCO results may leave out the frames after the last
+    /// detection.
+    pub complete: bool,
 }
 
 /// Why a keypoints file cannot be used.
@@ -235,9 +240,10 @@ impl Keypoints {
         Ok(keypoints)
     }
 
-    /// Checks the keypoints against a video of `frames` frames of `width` ×
-    /// `height`, and drops the points outside it; returns how many.
-    pub fn fit_to(&mut self, width: usize, height: usize, frames: usize) -> Result<usize, KeypointsError> {
+    /// Checks the keypoints against frames of `width` × `height` (where
+    /// the file states a size) and drops the points outside them; returns
+    /// how many.
+    pub fn fit_to(&mut self, width: usize, height: usize) -> Result<usize, KeypointsError> {
         if let Some((w, h)) = self.size
             && (w, h) != (width, height)
         {
@@ -249,13 +255,6 @@ impl Keypoints {
                 frame_height: height,
             });
         }
-        if self.frames.len() != frames {
-            return Err(KeypointsError::FrameCount {
-                path: self.path.clone(),
-                found: self.frames.len(),
-                expected: frames,
-            });
-        }
         let inside = |k: &Keypoint| k.x >= 0.0 && k.y >= 0.0 && k.x <= width as f64 && k.y <= height as f64;
         let mut outside = 0;
         for point in self.frames.iter_mut().flatten() {
@@ -265,6 +264,19 @@ impl Keypoints {
             }
         }
         Ok(outside)
+    }
+
+    /// Refuses keypoints of another number of frames than the video's
+    /// `frames` (where the file may leave frames out, of more).
+    pub fn check_frames(&self, frames: usize) -> Result<(), KeypointsError> {
+        if self.frames.len() > frames || (self.complete && self.frames.len() != frames) {
+            return Err(KeypointsError::FrameCount {
+                path: self.path.clone(),
+                found: self.frames.len(),
+                expected: frames,
+            });
+        }
+        Ok(())
     }
 }
 
@@ -321,7 +333,7 @@ fn read_csv(path: &Path, text: &str) -> Result<Keypoints, String> {
         }
         put(&mut frames[frame], site, x, y, confidence, &mut dropped);
     }
-    Ok(Keypoints { path: path.to_path_buf(), layout: None, size: None, frames, dropped })
+    Ok(Keypoints { path: path.to_path_buf(), layout: None, size: None, frames, dropped, complete: false })
 }
 
 fn read_json(path: &Path, text: &str) -> Result<Keypoints, String> {
@@ -368,7 +380,7 @@ fn read_document(path: &Path, document: &Value) -> Result<Keypoints, String> {
         }
         frames.push(points);
     }
-    Ok(Keypoints { path: path.to_path_buf(), layout, size, frames, dropped })
+    Ok(Keypoints { path: path.to_path_buf(), layout, size, frames, dropped, complete: true })
 }
 
 /// COCO results: `{"image_id": frame, "keypoints": [x, y, c, …]}` per
@@ -402,7 +414,14 @@ fn read_coco(path: &Path, detections: &[Value]) -> Result<Keypoints, String> {
             points
         })
         .collect();
-    Ok(Keypoints { path: path.to_path_buf(), layout: Some(Layout::Coco17), size: None, frames, dropped })
+    Ok(Keypoints {
+        path: path.to_path_buf(),
+        layout: Some(Layout::Coco17),
+        size: None,
+        frames,
+        dropped,
+        complete: false,
+    })
 }
 
 /// A flat `[x, y, c, …]` array into sites; (0, 0, 0) is OpenPose's "not found".
@@ -455,7 +474,7 @@ fn read_openpose(folder: &Path) -> Result<Keypoints, KeypointsError> {
         }
         frames.push(points);
     }
-    Ok(Keypoints { path: folder.to_path_buf(), layout, size: None, frames, dropped })
+    Ok(Keypoints { path: folder.to_path_buf(), layout, size: None, frames, dropped, complete: true })
 }
 
 #[cfg(test)]
@@ -530,9 +549,10 @@ mod tests {
         let csv =
             write(dir.path(), "k.csv", "frame,joint,x,y,confidence\n0,left_wrist,10,20,1\n2,left_wrist,70,20,1\n");
         let mut k = Keypoints::read(&csv).unwrap();
-        let e = k.clone().fit_to(64, 48, 5).unwrap_err().to_string();
-        assert!(e.contains("k.csv") && e.contains("3 frames") && e.contains("5"), "{e}");
-        assert_eq!(k.fit_to(64, 48, 3).unwrap(), 1, "x = 70 is outside 64 columns");
+        let e = k.check_frames(2).unwrap_err().to_string();
+        assert!(e.contains("k.csv") && e.contains("3 frames") && e.contains("2"), "{e}");
+        k.check_frames(5).expect("frames after the last detection may be left out of a CSV");
+        assert_eq!(k.fit_to(64, 48).unwrap(), 1, "x = 70 is outside 64 columns");
         for (name, text, says) in [
             ("a.csv", "frame,x,y\n", "no `joint` column"),
             ("b.csv", "frame,joint,x,y,confidence\n0,left_wrist,ten,2,1\n", "`ten` is not a number"),

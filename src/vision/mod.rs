@@ -12,5 +12,6 @@ pub mod noise;
 pub mod render;
 pub mod scorer;
 pub mod shape;
+pub mod sighting;
 pub mod silhouette;
 pub mod truth;

@@ -1,0 +1,134 @@
+//! What one frame shows of the person, the tracker's observation: the
+//! silhouette (scored by eq. 8's R), 2-D keypoints from a detector (scored
+//! by a Gaussian on the confidence-weighted reprojection error), or both,
+//! their scores multiplied.
+
+use crate::mocap::body::{Body, Joint};
+use crate::mocap::pose::BodyFrame;
+use crate::vision::camera::Camera;
+use crate::vision::distance::Observation;
+use crate::vision::keypoints::{Site, SitePoints};
+use crate::vision::mask::Mask;
+use glam::DVec3;
+
+/// A detector's typical error, as a share of the person's torso (the
+/// mid-shoulder to mid-hip length): PCK@0.2, the usual bar of a good 2-D
+/// pose estimate, is two of these.
+pub const KEYPOINT_SIGMA_TORSO_SHARE: f64 = 0.1;
+
+/// The largest keypoint energy scored: beyond it every pose explains the
+/// points equally badly, and the score stays a positive number.
+const MAX_ENERGY: f64 = 600.0;
+
+/// One frame's observation; at least one of the two parts.
+#[derive(Clone, Debug)]
+pub struct Sighting {
+    silhouette: Option<Observation>,
+    keypoints: Option<KeypointTarget>,
+}
+
+impl Sighting {
+    /// The frame's silhouette alone.
+    pub fn silhouette(mask: Mask) -> Sighting {
+        Sighting { silhouette: Some(Observation::new(mask)), keypoints: None }
+    }
+
+    /// A silhouette (`None`, or empty, when the frame shows none) and
+    /// keypoints; `None` when neither shows the person.
+    pub fn of(silhouette: Option<&Mask>, keypoints: Option<KeypointTarget>) -> Option<Sighting> {
+        let silhouette = silhouette.filter(|m| m.count() > 0).map(|m| Observation::new(m.clone()));
+        (silhouette.is_some() || keypoints.is_some()).then_some(Sighting { silhouette, keypoints })
+    }
+
+    /// The silhouette, when the frame has one.
+    pub fn mask(&self) -> Option<&Mask> {
+        self.silhouette.as_ref().map(Observation::mask)
+    }
+
+    pub fn observation(&self) -> Option<&Observation> {
+        self.silhouette.as_ref()
+    }
+
+    pub fn keypoints(&self) -> Option<&KeypointTarget> {
+        self.keypoints.as_ref()
+    }
+}
+
+/// A frame's keypoints, in pixels of the frames the camera sees, with the
+/// spread their score allows.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KeypointTarget {
+    points: SitePoints,
+    /// The Gaussian's standard deviation, pixels.
+    sigma_px: f64,
+}
+
+impl KeypointTarget {
+    /// `points` scored with a standard deviation of `sigma_px`; `None`
+    /// without a point, or for a spread that is not a positive number.
+    pub fn new(points: SitePoints, sigma_px: f64) -> Option<KeypointTarget> {
+        (points.iter().any(Option::is_some) && sigma_px.is_finite() && sigma_px > 0.0)
+            .then_some(KeypointTarget { points, sigma_px })
+    }
+
+    pub fn points(&self) -> &SitePoints {
+        &self.points
+    }
+
+    /// The torso's length in `points`, pixels: mid-shoulder to mid-hip
+    /// (either side's point standing in for a missing other), or the neck
+    /// and mid-hip of OpenPose's layouts; `None` when not seen.
+    pub fn torso_px(points: &SitePoints) -> Option<f64> {
+        let at = |s: Site| points[s.index()].map(|k| (k.x, k.y));
+        let middle = |a: Site, b: Site| match (at(a), at(b)) {
+            (Some(p), Some(q)) => Some(((p.0 + q.0) / 2.0, (p.1 + q.1) / 2.0)),
+            (p, q) => p.or(q),
+        };
+        let top = middle(Site::LeftShoulder, Site::RightShoulder).or_else(|| at(Site::Neck))?;
+        let bottom = middle(Site::LeftHip, Site::RightHip).or_else(|| at(Site::MidHip))?;
+        let length = (top.0 - bottom.0).hypot(top.1 - bottom.1);
+        (length > 0.0).then_some(length)
+    }
+
+    /// Σ c·d² / 2σ² over the points, d each point's distance (pixels) from
+    /// where `camera` sees its site on `world`.
+    pub fn energy(&self, camera: &Camera, body: &Body, world: &BodyFrame) -> f64 {
+        let mut energy = 0.0;
+        for (site, point) in Site::ALL.iter().zip(&self.points) {
+            let Some(point) = point else { continue };
+            // A site behind the camera is as far off as a point can count.
+            let d2 = camera
+                .project(site_position(*site, body, world))
+                .map_or(f64::INFINITY, |(u, v, _)| (u - point.x).powi(2) + (v - point.y).powi(2));
+            energy += point.confidence * d2;
+        }
+        (energy / (2.0 * self.sigma_px * self.sigma_px)).min(MAX_ENERGY)
+    }
+}
+
+/// Where the skeleton has `site`. The nose, which the skeleton lacks,
+/// stands in front of the head's base, 45% of the head's length up and
+/// forward.
+pub fn site_position(site: Site, body: &Body, world: &BodyFrame) -> DVec3 {
+    let joint = |j: Joint| world.position(j);
+    match site {
+        Site::Nose => {
+            let length = body.bone(Joint::Head).length();
+            joint(Joint::Head) + world.rotation(Joint::Head) * (DVec3::new(0.0, 0.45, 0.45) * length)
+        }
+        Site::Neck => joint(Joint::Neck),
+        Site::LeftShoulder => joint(Joint::LeftShoulder),
+        Site::RightShoulder => joint(Joint::RightShoulder),
+        Site::LeftElbow => joint(Joint::LeftElbow),
+        Site::RightElbow => joint(Joint::RightElbow),
+        Site::LeftWrist => joint(Joint::LeftWrist),
+        Site::RightWrist => joint(Joint::RightWrist),
+        Site::MidHip => (joint(Joint::LeftHip) + joint(Joint::RightHip)) / 2.0,
+        Site::LeftHip => joint(Joint::LeftHip),
+        Site::RightHip => joint(Joint::RightHip),
+        Site::LeftKnee => joint(Joint::LeftKnee),
+        Site::RightKnee => joint(Joint::RightKnee),
+        Site::LeftAnkle => joint(Joint::LeftAnkle),
+        Site::RightAnkle => joint(Joint::RightAnkle),
+    }
+}
