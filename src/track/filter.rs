@@ -7,12 +7,17 @@ use crate::track::root::{Root, RootSearch};
 use crate::vision::scorer::Scorer;
 use crate::vision::sighting::Sighting;
 use crate::vocab::primitive::Primitive;
+use glam::DVec3;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 /// The frame rate [`FilterParams::standard`] was tuned at (the paper's
 /// camera's).
 const TUNED_FPS: f64 = 15.0;
+
+/// How far (pixels) where the sighting places the person must be from
+/// where the root stands for [`Filter::follow`] to consider moving it.
+const FOLLOW_MIN_PX: f64 = 3.0;
 
 /// Passes of [`Root::align`] when a filter is placed.
 const ALIGN_PASSES: usize = 2;
@@ -207,16 +212,11 @@ impl<'v> Filter<'v> {
         }
         let (_, mut root, j) = best;
         let x = self.particle_pose(j);
-        // Placed from a silhouette, the lowest row is the nearest toe, not
-        // the point under the pelvis: moved until the drawn body stands
-        // where the person does (a second pass settles the pixel it
-        // rounds to).
-        if sighting.mask().is_some() {
-            let (placed, camera) = (self.root.position, self.scorer.camera().clone());
-            for _ in 0..ALIGN_PASSES {
-                root.align(&camera, self.scorer.draw(&root.pose(&x)), placed);
-            }
-            self.evaluations += ALIGN_PASSES as u64;
+        // A second pass settles the pixel the silhouette's footprint
+        // rounds to.
+        let placed = self.root.position;
+        for _ in 0..ALIGN_PASSES {
+            root = self.moved_to(root, &x, sighting, placed);
         }
         let score = self.score(sighting, &x, &root);
         let search = RootSearch { steps: climb, ..self.params.root };
@@ -225,13 +225,50 @@ impl<'v> Filter<'v> {
         self.root = root;
     }
 
+    /// `root` moved over the floor to where `sighting` places the person
+    /// (`anchor`, where [`Root::from_silhouette`] or
+    /// [`Root::from_keypoints`] put them) with the body in pose `x`: from a
+    /// silhouette, until the body drawn has its footprint there too (the
+    /// lowest row is the nearest toe, not the point under the pelvis).
+    fn moved_to(&mut self, mut root: Root, x: &JointVector, sighting: &Sighting, anchor: DVec3) -> Root {
+        if sighting.mask().is_some() {
+            let camera = self.scorer.camera().clone();
+            root.align(&camera, self.scorer.draw(&root.pose(x)), anchor);
+            self.evaluations += 1;
+        } else {
+            root.position = DVec3::new(anchor.x, root.position.y, anchor.z);
+        }
+        root
+    }
+
+    /// The root as it was, or moved over the floor to `anchor` (where the
+    /// sighting's keypoints place the pelvis), whichever explains the
+    /// frame better with the particles' mean pose. A walking or running
+    /// person goes farther between frames than the root's hill climb
+    /// reaches.
+    pub fn follow(&mut self, sighting: &Sighting, anchor: DVec3) -> Root {
+        let x = self.primitive.reconstruct(&self.mean());
+        let stay = self.root;
+        let moved = Root { position: DVec3::new(anchor.x, stay.position.y, anchor.z), ..stay };
+        // Within a few pixels the move is the detector's jitter, not the
+        // person: the hill climb refines from where the root is.
+        let camera = self.scorer.camera();
+        let seen = |r: &Root| camera.project(r.position.with_y(0.0)).map(|(u, v, _)| glam::DVec2::new(u, v));
+        if let (Some(a), Some(b)) = (seen(&moved), seen(&stay))
+            && a.distance(b) < FOLLOW_MIN_PX
+        {
+            return stay;
+        }
+        if self.score(sighting, &x, &moved) > self.score(sighting, &x, &stay) { moved } else { stay }
+    }
+
     /// One frame: every particle moves through the bending cone (or a few
-    /// are renewed from the training poses); with a
-    /// sighting it is weighted by its likelihood, the estimate is the
-    /// better of the weighted mean and the best particle, the root is
-    /// refined for it, and the particles are resampled. Without one (an
-    /// empty silhouette) the filter coasts: the particles move and the
-    /// estimate is their mean.
+    /// are renewed from the training poses); with a sighting it is
+    /// weighted by its likelihood, the estimate is the better of the
+    /// weighted mean and the best particle, the root is refined for it,
+    /// and the particles are resampled. Without one (an empty silhouette)
+    /// the filter coasts: the particles move and the estimate is their
+    /// mean.
     pub fn step(&mut self, sighting: Option<&Sighting>) -> Estimate {
         let (d, n) = (self.primitive.dims(), self.params.particles);
         let step = self.step_length();
@@ -278,7 +315,7 @@ impl<'v> Filter<'v> {
         } else {
             (self.particles[best * d..(best + 1) * d].to_vec(), self.particle_pose(best), scores[best])
         };
-        let mut root = self.root;
+        let mut root = root;
         let score = self.params.root.refine(&mut root, &x, score, sighting, &mut self.scorer, &mut self.rng);
         self.evaluations += self.params.root.steps as u64;
         self.root = root;

@@ -176,7 +176,7 @@ mod tests {
     use crate::vision::camera::Preset;
 
     #[test]
-    fn the_root_is_placed_under_the_person_from_the_front_side_and_overhead() {
+    fn the_root_is_placed_under_the_person_from_the_front_side_and_overhead_and_by_the_ankles() {
         let body = Body::standard();
         let mut pose = Pose::rest(&body);
         pose.root = DVec3::new(0.2, body.pelvis_height(), -0.3);
@@ -192,6 +192,18 @@ mod tests {
             assert!(off < 0.25, "{preset:?}: placed {off:.2} m away");
             assert_eq!(root.position.y, body.pelvis_height());
         }
+        // From keypoints: the ankles where the camera sees them.
+        let camera = Camera::preset(Preset::Front, 160, 120).unwrap();
+        let world = body.forward(&pose);
+        let mut points = [None; 15];
+        for (site, joint) in [(Site::LeftAnkle, Joint::LeftAnkle), (Site::RightAnkle, Joint::RightAnkle)] {
+            let (x, y, _) = camera.project(world.position(joint)).unwrap();
+            points[site.index()] = Some(crate::vision::keypoints::Keypoint { x, y, confidence: 1.0 });
+        }
+        let root = Root::from_keypoints(&camera, &points, &body).unwrap();
+        let off = (root.position - pose.root).with_y(0.0).length();
+        assert!(off < 0.02, "placed {off:.3} m from the pelvis by its ankles");
+        assert!(Root::from_keypoints(&camera, &[None; 15], &body).is_none());
         let empty = Mask::new(160, 120);
         assert!(Root::from_silhouette(&Camera::preset(Preset::Front, 160, 120).unwrap(), &empty, 1.0, 0.0).is_none());
     }

@@ -176,8 +176,10 @@ impl<'v> Tracker<'v> {
     pub fn step_seen(&mut self, silhouette: Option<&Mask>, keypoints: Option<&SitePoints>) -> FrameEstimate {
         let target = keypoints.and_then(|k| self.keypoint_target(k));
         let sighting = Sighting::of(silhouette, target);
-        if let (false, Some(sighting)) = (self.placed, &sighting) {
-            self.place(sighting);
+        match (self.placed, &sighting) {
+            (false, Some(sighting)) => self.place(sighting),
+            (true, Some(sighting)) => self.follow(sighting),
+            _ => {}
         }
         let estimates: Vec<Estimate> = self.filters.par_iter_mut().map(|f| f.step(sighting.as_ref())).collect();
         let probabilities = match sighting {
@@ -300,15 +302,35 @@ impl<'v> Tracker<'v> {
         self.physique = physique;
     }
 
-    /// Puts every filter's root on the person the first time one shows:
-    /// under their silhouette, or else their keypoints.
-    fn place(&mut self, sighting: &Sighting) {
+    /// Where the sighting places the person: under their silhouette, or
+    /// else their keypoints.
+    fn anchor(&self, sighting: &Sighting) -> Option<Root> {
         let body = &self.physique.body;
-        let root = match sighting.mask() {
+        match sighting.mask() {
             Some(mask) => Root::from_silhouette(&self.camera, mask, body.pelvis_height(), 0.0),
             None => sighting.keypoints().and_then(|k| Root::from_keypoints(&self.camera, k.points(), body)),
-        };
-        let Some(root) = root else { return };
+        }
+    }
+
+    /// Moves the person's root to where their keypoints' ankles (or hips)
+    /// place them when the last winner's filter, in its particles' mean
+    /// pose, explains the frame better there: one person, one root, as
+    /// after recognition. Silhouettes alone do not move it so: their
+    /// footprint is the feet's row, a pixel of it tens of centimetres of
+    /// floor through a wide lens, and shadows widen it; following it cost
+    /// recognition through 70° lenses at 160×120 (46 → 30% at 1.4 m high,
+    /// 4 m away).
+    fn follow(&mut self, sighting: &Sighting) {
+        let body = &self.physique.body;
+        let anchor = sighting.keypoints().and_then(|k| Root::from_keypoints(&self.camera, k.points(), body));
+        let Some(anchor) = anchor else { return };
+        let root = self.filters[self.winner].follow(sighting, anchor.position);
+        self.filters.iter_mut().for_each(|f| f.set_root(root));
+    }
+
+    /// Puts every filter's root on the person the first time one shows.
+    fn place(&mut self, sighting: &Sighting) {
+        let Some(root) = self.anchor(sighting) else { return };
         // A silhouette looks the same from the front as from the back, so
         // a prior breaks the tie: people mostly face the camera. Turned
         // away, a heading keeps half its score; at right angles, three
