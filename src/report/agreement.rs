@@ -6,7 +6,7 @@
 use crate::mocap::body::Joint;
 use crate::report::metrics::Track;
 use crate::vision::camera::Camera;
-use crate::vision::keypoints::{Keypoints, Site};
+use crate::vision::keypoints::{Keypoints, Site, torso_px};
 use std::collections::BTreeMap;
 
 /// The points PCK is counted over: shoulders, elbows, wrists and hips,
@@ -76,12 +76,12 @@ pub fn agreement(
     let mut by_point = [(0usize, 0usize); SCORED.len()];
     for (joints, seen) in run.joints.iter().zip(&reference.frames) {
         let at = |s: Site| seen[s.index()].map(|k| glam::DVec2::new(k.x, k.y));
-        let [ls, rs, lh, rh] = [Site::LeftShoulder, Site::RightShoulder, Site::LeftHip, Site::RightHip].map(at);
-        let (Some(ls), Some(rs), Some(lh), Some(rh)) = (ls, rs, lh, rh) else { continue };
-        let torso = ((ls + rs) / 2.0).distance((lh + rh) / 2.0);
-        if torso <= 0.0 {
+        // PCK measures against the torso only where all four corners show it.
+        let corners = [Site::LeftShoulder, Site::RightShoulder, Site::LeftHip, Site::RightHip];
+        if corners.iter().any(|&s| at(s).is_none()) {
             continue;
         }
+        let Some(torso) = torso_px(seen) else { continue };
         frames += 1;
         let projected = |j: Joint| camera.project(joints[j.index()]).map(|(u, v, _)| glam::DVec2::new(u, v));
         let within = |estimate: Option<glam::DVec2>, target: glam::DVec2| {

@@ -235,10 +235,10 @@ impl<'v> Filter<'v> {
             let camera = self.scorer.camera().clone();
             root.align(&camera, self.scorer.draw(&root.pose(x)), anchor);
             self.evaluations += 1;
+            root
         } else {
-            root.position = DVec3::new(anchor.x, root.position.y, anchor.z);
+            root.over(anchor)
         }
-        root
     }
 
     /// The root as it was, or moved over the floor to `anchor` (where the
@@ -247,9 +247,8 @@ impl<'v> Filter<'v> {
     /// person goes farther between frames than the root's hill climb
     /// reaches.
     pub fn follow(&mut self, sighting: &Sighting, anchor: DVec3) -> Root {
-        let x = self.primitive.reconstruct(&self.mean());
         let stay = self.root;
-        let moved = Root { position: DVec3::new(anchor.x, stay.position.y, anchor.z), ..stay };
+        let moved = stay.over(anchor);
         // Within a few pixels the move is the detector's jitter, not the
         // person: the hill climb refines from where the root is.
         let camera = self.scorer.camera();
@@ -259,6 +258,7 @@ impl<'v> Filter<'v> {
         {
             return stay;
         }
+        let x = self.primitive.reconstruct(&self.mean());
         if self.score(sighting, &x, &moved) > self.score(sighting, &x, &stay) { moved } else { stay }
     }
 

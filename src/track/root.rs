@@ -96,6 +96,12 @@ impl Root {
         }
     }
 
+    /// This root moved over the floor to above `point`: its height and
+    /// heading kept.
+    pub fn over(self, point: DVec3) -> Root {
+        Root { position: DVec3::new(point.x, self.position.y, point.z), ..self }
+    }
+
     /// Whether the ray through the bottom of the person's regions in
     /// `mask` points below the horizon, as it must for a person standing on
     /// the floor before a camera above it; `true` for an empty mask.

@@ -8,7 +8,7 @@ use crate::track::calibrate::{self, CalibrationParams, CalibrationReport, Height
 use crate::track::filter::{Estimate, Filter, FilterParams};
 use crate::track::root::Root;
 use crate::vision::camera::Camera;
-use crate::vision::keypoints::SitePoints;
+use crate::vision::keypoints::{SitePoints, torso_px};
 use crate::vision::mask::Mask;
 use crate::vision::scorer::Scorer;
 use crate::vision::sighting::{KEYPOINT_SIGMA_TORSO_SHARE, KeypointTarget, Sighting};
@@ -213,7 +213,7 @@ impl<'v> Tracker<'v> {
     /// widened by the square root of the filters' sharpness, which their
     /// weights raise each score to. `None` before any torso was seen.
     fn keypoint_target(&mut self, points: &SitePoints) -> Option<KeypointTarget> {
-        if let Some(torso) = KeypointTarget::torso_px(points) {
+        if let Some(torso) = torso_px(points) {
             self.torso_px = Some(torso);
         }
         let sigma = KEYPOINT_SIGMA_TORSO_SHARE * self.torso_px? * self.params.filter.sharpness.sqrt();

@@ -280,6 +280,21 @@ impl Keypoints {
     }
 }
 
+/// The torso's length in `points`, pixels: mid-shoulder to mid-hip
+/// (either side's point standing in for a missing other), or the neck and
+/// mid-hip of OpenPose's layouts; `None` when not seen.
+pub fn torso_px(points: &SitePoints) -> Option<f64> {
+    let at = |s: Site| points[s.index()].map(|k| (k.x, k.y));
+    let middle = |a: Site, b: Site| match (at(a), at(b)) {
+        (Some(p), Some(q)) => Some(((p.0 + q.0) / 2.0, (p.1 + q.1) / 2.0)),
+        (p, q) => p.or(q),
+    };
+    let top = middle(Site::LeftShoulder, Site::RightShoulder).or_else(|| at(Site::Neck))?;
+    let bottom = middle(Site::LeftHip, Site::RightHip).or_else(|| at(Site::MidHip))?;
+    let length = (top.0 - bottom.0).hypot(top.1 - bottom.1);
+    (length > 0.0).then_some(length)
+}
+
 /// A point worth keeping: finite, with some confidence (clamped to 1).
 fn usable(x: f64, y: f64, confidence: f64) -> Option<Keypoint> {
     (x.is_finite() && y.is_finite() && confidence.is_finite() && confidence > 0.0).then_some(Keypoint {

@@ -75,21 +75,6 @@ impl KeypointTarget {
         &self.points
     }
 
-    /// The torso's length in `points`, pixels: mid-shoulder to mid-hip
-    /// (either side's point standing in for a missing other), or the neck
-    /// and mid-hip of OpenPose's layouts; `None` when not seen.
-    pub fn torso_px(points: &SitePoints) -> Option<f64> {
-        let at = |s: Site| points[s.index()].map(|k| (k.x, k.y));
-        let middle = |a: Site, b: Site| match (at(a), at(b)) {
-            (Some(p), Some(q)) => Some(((p.0 + q.0) / 2.0, (p.1 + q.1) / 2.0)),
-            (p, q) => p.or(q),
-        };
-        let top = middle(Site::LeftShoulder, Site::RightShoulder).or_else(|| at(Site::Neck))?;
-        let bottom = middle(Site::LeftHip, Site::RightHip).or_else(|| at(Site::MidHip))?;
-        let length = (top.0 - bottom.0).hypot(top.1 - bottom.1);
-        (length > 0.0).then_some(length)
-    }
-
     /// Σ c·d² / 2σ² over the points, d each point's distance (pixels) from
     /// where `camera` sees its site on `world`.
     pub fn energy(&self, camera: &Camera, body: &Body, world: &BodyFrame) -> f64 {
