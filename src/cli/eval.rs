@@ -2,8 +2,9 @@
 
 mod mocap;
 mod person;
+mod video;
 
-use super::report::silhouettes;
+use super::report::{silhouettes, tracked_camera};
 use super::{Global, Outcome, UsageError, arg, invoke, refuse_nonempty};
 use anyhow::Context;
 use imitate::fsutil::write_dir_atomic;
@@ -51,6 +52,17 @@ pub struct Args {
     /// labels.csv (skipped when absent).
     #[arg(long, value_name = "DIR", default_value = "../shared/mocap")]
     pub mocap: PathBuf,
+    /// Real clips for the real-video table: a folder of videos and a
+    /// labels.csv (`file,activity,camera,…`), tracked with a vocabulary
+    /// learned from the corpora of --mocap (skipped when not given).
+    #[arg(long, value_name = "DIR")]
+    pub real_video: Option<PathBuf>,
+    /// MediaPipe Pose's masks and landmarks of the --real-video clips, as
+    /// `bash scripts/video-reference.sh DIR` writes them (NAME/keypoints.csv
+    /// and NAME/masks/ per clip): adds the silhouettes' IoU and the PCK
+    /// columns.
+    #[arg(long, value_name = "DIR", requires = "real_video")]
+    pub video_reference: Option<PathBuf>,
     /// Keep the trials' videos and runs here [default: a temporary folder,
     /// removed afterwards].
     #[arg(long, value_name = "DIR")]
@@ -259,9 +271,9 @@ impl Work {
 fn strip(run_dir: &Path, video: &Video, name: &str, caption: &str) -> anyhow::Result<Picture> {
     let run = Run::read(run_dir)?;
     let truth = read_track(&video.truth)?;
-    let camera = Camera::new(run.summary.camera.clone(), &arg(&run_dir.join("summary.json")))?;
+    let camera = tracked_camera(&run)?;
     let picks = pick_frames(run.track.frame.len(), 8);
-    let observed = silhouettes(&video.frames, run.track.frame.len(), &picks)?;
+    let observed = silhouettes(&video.frames, run.track.frame.len(), &picks, camera.width())?;
     let png = filmstrip(&camera, &run.track, Some(&truth), &picks, &observed);
     Ok(Picture { name: name.into(), png, svg: None, caption: caption.into() })
 }
@@ -383,17 +395,26 @@ fn evaluate(args: &Args, global: Global, dir: &Path) -> anyhow::Result<Outcome> 
     if let Some(real) = real_trial(&work, &args.real)? {
         trials.push(real);
     }
-    let (tables, styles) = mocap::section(&work, &args.mocap)?;
+    let (mut tables, styles) = mocap::section(&work, &args.mocap)?;
     trials.extend(styles);
+    let mut table_timing = Vec::new();
+    if let Some(clips) = &args.real_video {
+        let vocab = video::mocap_vocabulary(&work, &args.mocap)?;
+        let (table, timing) = video::section(&work, clips, args.video_reference.as_deref(), &vocab)?;
+        tables.push(table);
+        table_timing = timing;
+    }
     work.bar.finish_and_clear();
 
     let first_run = Run::read(&first)?;
     let first_metrics = score(&first_run.track, &read_track(&front.truth)?, &first_run.primitives, 0.5)?;
     let provenance = Provenance {
         command: format!(
-            "imitate eval{}{} --seed {}",
+            "imitate eval{}{}{}{} --seed {}",
             if args.quick { " --quick" } else { "" },
             args.vocab.as_ref().map_or(String::new(), |v| format!(" --vocab {}", v.display())),
+            args.real_video.as_ref().map_or(String::new(), |v| format!(" --real-video {}", v.display())),
+            args.video_reference.as_ref().map_or(String::new(), |v| format!(" --video-reference {}", v.display())),
             args.seed
         ),
         seed: args.seed,
@@ -406,7 +427,8 @@ fn evaluate(args: &Args, global: Global, dir: &Path) -> anyhow::Result<Outcome> 
                 .collect::<Vec<_>>(),
         }),
     };
-    let files = eval_report(&provenance, &trials, &tables, &first_metrics.recognition.confusion, &machine());
+    let confusion = &first_metrics.recognition.confusion;
+    let files = eval_report(&provenance, &trials, &tables, confusion, &table_timing, &machine());
     let shown = arg(&args.output);
     let io = |e: std::io::Error| anyhow::anyhow!("{shown}: cannot write: {e}");
     let write = |d: &Path| files.iter().try_for_each(|(name, bytes)| std::fs::write(d.join(name), bytes)).map_err(io);

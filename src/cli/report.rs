@@ -53,8 +53,13 @@ pub struct Args {
 }
 
 /// The silhouettes of frames `picks` of `input`, which must hold `frames`
-/// frames.
-pub(super) fn silhouettes(input: &Path, frames: usize, picks: &[usize]) -> anyhow::Result<Vec<Mask>> {
+/// frames, at most `work_width` pixels wide (as `track --work-size`).
+pub(super) fn silhouettes(
+    input: &Path,
+    frames: usize,
+    picks: &[usize],
+    work_width: usize,
+) -> anyhow::Result<Vec<Mask>> {
     let source = FrameSource::open(input, Expect::Auto)?;
     if let Some(n) = source.frame_count().filter(|&n| n != frames) {
         bail!(
@@ -62,7 +67,7 @@ pub(super) fn silhouettes(input: &Path, frames: usize, picks: &[usize]) -> anyho
             input.display()
         );
     }
-    let mut silhouettes = Silhouettes::new(input, source, None);
+    let mut silhouettes = Silhouettes::new(input, source, None, work_width);
     let (mut mask, mut out, mut k) = (Mask::new(1, 1), Vec::new(), 0);
     while out.len() < picks.len() {
         match silhouettes.next_into(&mut mask) {
@@ -77,6 +82,18 @@ pub(super) fn silhouettes(input: &Path, frames: usize, picks: &[usize]) -> anyho
     Ok(out)
 }
 
+/// The camera a run's silhouettes were seen through: its camera at the
+/// size its frames were reduced to.
+pub(super) fn tracked_camera(run: &Run) -> anyhow::Result<Camera> {
+    let summary = run.dir.join("summary.json");
+    let camera = Camera::new(run.summary.camera.clone(), &summary.display().to_string())
+        .with_context(|| format!("{}: the camera", summary.display()))?;
+    Ok(match run.summary.work_size {
+        Some([width, height]) => camera.resized(width, height),
+        None => camera,
+    })
+}
+
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     if !(args.settle.is_finite() && args.settle >= 0.0) {
         return Err(UsageError(format!("--settle {}: must be a number of seconds, 0 or more", args.settle)).into());
@@ -85,16 +102,16 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     refuse_nonempty(&output, args.force)?;
     let run = Run::read(&args.run)?;
     let summary = args.run.join("summary.json");
-    let camera = Camera::new(run.summary.camera.clone(), &summary.display().to_string())
-        .with_context(|| format!("{}: the camera", summary.display()))?;
+    let camera = tracked_camera(&run)?;
     let truth = args.truth.as_deref().map(read_track).transpose()?;
     let metrics = truth.as_ref().map(|t| score(&run.track, t, &run.primitives, args.settle)).transpose()?;
     let input = args.frames.clone().unwrap_or_else(|| PathBuf::from(&run.summary.input));
     let picks = pick_frames(run.track.frame.len(), MAX_FRAMES);
-    let observed = silhouettes(&input, run.track.frame.len(), &picks).with_context(|| match &args.frames {
-        Some(_) => "--frames".to_string(),
-        None => format!("the frames {} names (pass --frames if they moved)", summary.display()),
-    })?;
+    let observed =
+        silhouettes(&input, run.track.frame.len(), &picks, camera.width()).with_context(|| match &args.frames {
+            Some(_) => "--frames".to_string(),
+            None => format!("the frames {} names (pass --frames if they moved)", summary.display()),
+        })?;
     let truth_view = truth.as_ref().zip(metrics.as_ref()).map(|(track, metrics)| Truth { track, metrics });
     let imitation = args.execution.as_deref().map(|dir| read_imitation(dir, &run.track)).transpose()?;
     let mut files = run_report(&run, truth_view, imitation.as_ref(), &camera, &picks, &observed);

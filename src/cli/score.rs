@@ -1,13 +1,18 @@
 //! `imitate score`: a tracking run against the truth of its video.
 
+use super::report::tracked_camera;
 use super::{Global, Outcome, UsageError, note};
 use anyhow::Context;
 use imitate::fsutil::write_atomic;
 use imitate::report::agreement::agreement;
+use imitate::report::mask_agreement::mask_agreement;
 use imitate::report::metrics::{Metrics, score};
+use imitate::report::run::Run;
 use imitate::report::{read_primitives, read_track};
 use imitate::vision::camera::Camera;
+use imitate::vision::frames::{Expect, FrameSource};
 use imitate::vision::keypoints::Keypoints;
+use imitate::vision::silhouette::Silhouettes;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -22,7 +27,7 @@ use std::path::PathBuf;
 /// matched row by row; writes metrics.json (see docs/formats.md). With
 /// --keypoints, reads RUN_DIR/camera.json too and writes agreement.json.
 #[derive(Debug, clap::Args)]
-#[command(group(clap::ArgGroup::new("against").required(true).args(["truth", "keypoints"])))]
+#[command(group(clap::ArgGroup::new("against").required(true).args(["truth", "keypoints", "masks"])))]
 pub struct Args {
     /// The tracking run's folder.
     #[arg(value_name = "RUN_DIR")]
@@ -36,8 +41,16 @@ pub struct Args {
     /// lengths of them.
     #[arg(long, value_name = "FILE")]
     pub keypoints: Option<PathBuf>,
+    /// Reference person masks of the same frames: a folder of images,
+    /// white where the person is, one per frame in name order (as
+    /// `scripts/keypoints.sh --masks` writes MediaPipe's): the run's
+    /// silhouettes, made again from its frames, compared by intersection
+    /// over union at the run's working size.
+    #[arg(long, value_name = "DIR")]
+    pub masks: Option<PathBuf>,
     /// Where to write the metrics [default: RUN_DIR/metrics.json, or
-    /// RUN_DIR/agreement.json with --keypoints].
+    /// RUN_DIR/agreement.json with --keypoints, RUN_DIR/silhouettes.json
+    /// with --masks].
     #[arg(short, long, value_name = "FILE.json")]
     pub output: Option<PathBuf>,
     /// Seconds after each switch of the true activity that the settled
@@ -55,6 +68,28 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     }
     let estimate = read_track(&args.run.join("frames.csv"))?;
     let (json, output, line) = match (&args.truth, &args.keypoints) {
+        _ if args.masks.is_some() => {
+            let masks = args.masks.as_deref().expect("matched");
+            let run = Run::read(&args.run)?;
+            let camera = tracked_camera(&run)?;
+            let input = PathBuf::from(&run.summary.input);
+            let source = FrameSource::open(&input, Expect::Auto)?;
+            let mut silhouettes = Silhouettes::new(&input, source, run.summary.background_plate(), camera.width());
+            let agreement = mask_agreement(&mut silhouettes, masks)?;
+            let output = args.output.clone().unwrap_or_else(|| args.run.join("silhouettes.json"));
+            let line = format!(
+                "{} frames at {}×{}: mean IoU {:.3} (lowest {:.3}), recall {:.3}, precision {:.3} → {}",
+                agreement.frames,
+                agreement.work_size[0],
+                agreement.work_size[1],
+                agreement.mean_iou,
+                agreement.min_iou,
+                agreement.recall,
+                agreement.precision,
+                output.display()
+            );
+            (serde_json::to_string_pretty(&agreement), output, line)
+        }
         (Some(truth), _) => {
             let truth = read_track(truth)?;
             let primitives = read_primitives(&args.run.join("summary.json"))?;

@@ -19,6 +19,7 @@ use imitate::vision::camera::Camera;
 use imitate::vision::frames::{Expect, FrameSource, beside_frames, video_frame_rate};
 use imitate::vision::keypoints::{Keypoints, SitePoints};
 use imitate::vision::mask::Mask;
+use imitate::vision::resize::{DEFAULT_WORK_WIDTH, shrink_mask, work_size};
 use imitate::vision::silhouette::Silhouettes;
 use imitate::vision::truth;
 use imitate::vocab::vocabulary::Vocabulary;
@@ -91,10 +92,16 @@ pub struct Args {
     #[arg(long, conflicts_with = "height")]
     pub no_calibrate: bool,
     /// The empty scene, for color frames. Default: background.png beside
-    /// the frames (as `render --color` writes it), else the per-pixel
-    /// median of the frames.
+    /// the frames (as `render --color` writes it), else a background
+    /// learned from the frames (what the person does not cover).
     #[arg(long, value_name = "IMAGE")]
     pub background: Option<PathBuf>,
+    /// The width in pixels frames are reduced to, keeping their aspect,
+    /// for the silhouettes and the likelihood; frames no wider keep their
+    /// size, and 0 keeps every frame's own size. Outputs (camera.json,
+    /// keypoints) stay in the frames' own pixels.
+    #[arg(long, value_name = "PX", default_value_t = DEFAULT_WORK_WIDTH)]
+    pub work_size: usize,
     /// Run a baseline instead of the primitives' filters. `full-space`:
     /// one annealed particle filter over every joint angle and the root
     /// (Deutscher, Blake & Reid 2000), spending as many likelihood
@@ -237,6 +244,9 @@ fn given_camera(args: &Args, source: &FrameSource) -> anyhow::Result<Option<(Cam
     Ok(Some((camera, from)))
 }
 
+/// The width silhouettes are reduced to for comparing cameras.
+const PROBE_WIDTH: usize = 160;
+
 /// Reads silhouettes into `pending` until the calibration window's
 /// seconds of the person, with enough whole frames, are in (or it gives
 /// up), and estimates the camera from the whole ones.
@@ -250,7 +260,7 @@ fn estimate_camera(
 ) -> anyhow::Result<(Camera, CameraEstimate)> {
     let fps = 1.0 / params.filter.frame_time_s;
     let window = CalibrationParams::standard(None);
-    let (width, height) = (silhouettes.source().width(), silhouettes.source().height());
+    let (width, height) = silhouettes.size();
     let mut standings = Vec::new();
     let mut first_seen: Option<usize> = None;
     loop {
@@ -269,10 +279,18 @@ fn estimate_camera(
     }
     let focal = match (args.fov, args.focal) {
         (Some(deg), _) => Focal::Fov(deg),
-        (None, Some(px)) => Focal::Pixels(px),
+        // --focal is in the frames' own pixels.
+        (None, Some(px)) => Focal::Pixels(px * width as f64 / silhouettes.source().width() as f64),
         (None, None) => Focal::Assumed,
     };
-    let judge = &mut |camera: &Camera| auto_camera::explained(vocabulary, camera, pending, params);
+    // Cameras are compared on the silhouettes reduced to the paper's 160
+    // pixels wide: the ranking needs the body's outline, not its fingers,
+    // and each camera tracks every frame of the window.
+    let probe_size = work_size(width, height, PROBE_WIDTH);
+    let probes: Vec<Mask> = pending.iter().map(|m| shrink_mask(m, probe_size)).collect();
+    let judge = &mut |camera: &Camera| {
+        auto_camera::explained(vocabulary, &camera.resized(probe_size.0, probe_size.1), &probes, params)
+    };
     auto_camera::estimate(width, height, &standings, person, focal, judge).map_err(|e| {
         UsageError(format!(
             "{}: {e} (looked at the first {} s of the person); pass --camera (a preset or a camera.json)",
@@ -402,6 +420,11 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let (fps, rate_from) = frame_rate(&args, &source)?;
     let mut params = params(&args, fps)?;
     let mut given = given_camera(&args, &source)?;
+    let frame_size = (source.width(), source.height());
+    let work = work_size(frame_size.0, frame_size.1, args.work_size);
+    if let Some((camera, _)) = &mut given {
+        *camera = camera.resized(work.0, work.1);
+    }
     let observe = args.observe.unwrap_or(if args.keypoints.is_some() { Observe::Both } else { Observe::Silhouette });
     let (keypoints, keypoints_report) = match &args.keypoints {
         Some(path) => {
@@ -414,6 +437,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
                 "points_dropped": keypoints.dropped,
                 "points_outside_frames": outside,
             });
+            keypoints.rescale(frame_size, work);
             (Some(keypoints), Some(report))
         }
         None => (None, None),
@@ -423,7 +447,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     };
     // The timing includes estimating the camera.
     let started = Instant::now();
-    let mut silhouettes = Silhouettes::new(&args.input, source, args.background.clone());
+    let mut silhouettes = Silhouettes::new(&args.input, source, args.background.clone(), args.work_size);
+
     let mut pending = Vec::new();
     let (camera, camera_estimate) = match &given {
         Some((camera, _)) => (camera.clone(), None),
@@ -501,6 +526,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     }
     let seconds = started.elapsed().as_secs_f64();
     let evaluations = follower.evaluations() + camera_estimate.as_ref().map_or(0, |e| e.evaluations);
+    // The camera in the frames' own pixels, as the user's files are.
+    let seen_camera = camera.resized(frame_size.0, frame_size.1);
     let motion = Motion { body: follower.body().clone(), frame_time_s: 1.0 / fps, poses };
     let summary = serde_json::json!({
         "input": args.input.display().to_string(),
@@ -511,7 +538,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         "primitives": vocabulary.primitives().iter().map(|p| serde_json::json!({
             "name": p.name(), "label": p.majority_label(), "dims": p.dims(),
         })).collect::<Vec<_>>(),
-        "camera": camera.spec(),
+        "camera": seen_camera.spec(),
+        "work_size": [work.0, work.1],
         "camera_estimate": camera_estimate,
         "body": follower.calibration(),
         "background": silhouettes.background_used(),
@@ -533,7 +561,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     write_dir_atomic(
         &args.output,
         |dir| {
-            std::fs::write(dir.join("camera.json"), camera.to_json()).map_err(io)?;
+            std::fs::write(dir.join("camera.json"), seen_camera.to_json()).map_err(io)?;
             write_atomic(&dir.join("trajectory.bvh"), |w| write_bvh(&motion.to_bvh(), w)).map_err(io)?;
             write_atomic(&dir.join("frames.csv"), |w| {
                 w.write_all(header(&names).as_bytes())?;

@@ -293,11 +293,22 @@ fn headline(trials: &[Trial]) -> Vec<(String, String, String)> {
     numbers
 }
 
+/// The speed of one run a table stands on, for the report's timing.
+#[derive(Clone, Debug)]
+pub struct TimingRow {
+    pub trial: String,
+    pub series: String,
+    pub x: String,
+    pub frames_per_second: f64,
+    pub evaluations_per_frame: f64,
+}
+
 pub fn eval_report(
     provenance: &Provenance,
     trials: &[Trial],
     tables: &[Table],
     confusion: &BTreeMap<String, BTreeMap<String, usize>>,
+    table_timing: &[TimingRow],
     machine: &str,
 ) -> Vec<File> {
     let mut files: Vec<File> = Vec::new();
@@ -338,6 +349,10 @@ pub fn eval_report(
         }
     }
     metrics.insert("trials".into(), trial_metrics.into());
+    timing.extend(table_timing.iter().map(|t| {
+        let fps = Spread::of([t.frames_per_second]).expect("one value");
+        (t.trial.clone(), t.series.clone(), t.x.clone(), fps, t.evaluations_per_frame)
+    }));
     let mut table_metrics = serde_json::Map::new();
     for table in tables {
         page.heading(&table.title);

@@ -9,6 +9,7 @@ pub mod figures;
 pub mod filmstrip;
 pub mod html;
 pub mod imitation;
+pub mod mask_agreement;
 pub mod metrics;
 pub mod page;
 pub mod plot;

@@ -12,7 +12,16 @@ use std::path::{Path, PathBuf};
 pub struct RunSummary {
     /// The frames tracked, as given to `track`.
     pub input: String,
+    /// The camera, in the frames' own pixels.
     pub camera: CameraSpec,
+    /// The size frames were reduced to for tracking; absent in runs
+    /// written before `--work-size`, which tracked at the camera's size.
+    #[serde(default)]
+    pub work_size: Option<[usize; 2]>,
+    /// The background color frames were compared with: an image's path,
+    /// or what it was learned from.
+    #[serde(default)]
+    pub background: Option<String>,
     pub fps: f64,
     pub frames: usize,
     pub seed: u64,
@@ -22,6 +31,14 @@ pub struct RunSummary {
     pub settings: serde_json::Value,
     #[serde(default)]
     pub baseline: Option<serde_json::Value>,
+}
+
+impl RunSummary {
+    /// The background image the run was given, if it was one (and is still
+    /// there), to make its silhouettes again.
+    pub fn background_plate(&self) -> Option<PathBuf> {
+        self.background.as_ref().map(PathBuf::from).filter(|p| p.is_file())
+    }
 }
 
 #[derive(Clone, Debug, serde::Deserialize)]

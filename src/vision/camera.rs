@@ -162,6 +162,24 @@ impl Camera {
         Camera::new(preset.spec(width, height), preset.name())
     }
 
+    /// The same camera seeing frames reduced (or enlarged) to `width` ×
+    /// `height`: focal lengths and principal point scaled with each side (a
+    /// pixel spans `[i, i + 1)`, so a point at `u` moves to `u · width' /
+    /// width`).
+    pub fn resized(&self, width: usize, height: usize) -> Camera {
+        let (sx, sy) = (width as f64 / self.spec.width as f64, height as f64 / self.spec.height as f64);
+        let spec = CameraSpec {
+            width: width as u32,
+            height: height as u32,
+            fx: self.spec.fx * sx,
+            fy: self.spec.fy * sy,
+            cx: self.spec.cx * sx,
+            cy: self.spec.cy * sy,
+            ..self.spec.clone()
+        };
+        Camera { spec, ..self.clone() }
+    }
+
     /// Reads and checks a `camera.json`.
     pub fn read(path: &Path) -> Result<Camera, CameraError> {
         let name = path.display().to_string();
@@ -223,6 +241,18 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_resized_camera_sees_every_point_where_the_frame_scales_it() {
+        let full = Camera::preset(Preset::Side, 640, 480).unwrap();
+        let work = full.resized(320, 240);
+        for point in [DVec3::new(0.3, 1.6, -0.2), DVec3::new(-0.5, 0.1, 0.4)] {
+            let (u, v, depth) = full.project(point).unwrap();
+            let (u2, v2, depth2) = work.project(point).unwrap();
+            assert!((u2 - u / 2.0).abs() < 1e-9 && (v2 - v / 2.0).abs() < 1e-9 && (depth2 - depth).abs() < 1e-12);
+        }
+        assert_eq!(work.resized(640, 480).spec(), full.spec());
+    }
 
     #[test]
     fn the_front_preset_sees_the_person_upright_and_centred_with_their_left_on_the_image_right() {

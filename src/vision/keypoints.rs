@@ -266,6 +266,15 @@ impl Keypoints {
         Ok(outside)
     }
 
+    /// Moves every point from frames of `from` (width, height) to frames
+    /// of `to`, as the tracker's working size reduces them.
+    pub fn rescale(&mut self, from: (usize, usize), to: (usize, usize)) {
+        let (sx, sy) = (to.0 as f64 / from.0 as f64, to.1 as f64 / from.1 as f64);
+        for point in self.frames.iter_mut().flatten().flatten() {
+            (point.x, point.y) = (point.x * sx, point.y * sy);
+        }
+    }
+
     /// Refuses keypoints of another number of frames than the video's
     /// `frames` (where the file may leave frames out, of more).
     pub fn check_frames(&self, frames: usize) -> Result<(), KeypointsError> {

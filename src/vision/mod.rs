@@ -1,6 +1,7 @@
 //! What the tracker sees: a camera, the body drawn as capsules, silhouettes
 //! from frames, and the likelihood of a pose given a silhouette (eq. 8–9).
 
+pub mod background;
 pub mod camera;
 pub mod color;
 pub mod distance;
@@ -10,6 +11,7 @@ pub mod keypoints;
 pub mod mask;
 pub mod noise;
 pub mod render;
+pub mod resize;
 pub mod scorer;
 pub mod shape;
 pub mod sighting;

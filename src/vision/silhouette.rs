@@ -9,13 +9,15 @@
 //! found over runs of pixels rather than pixel by pixel. An [`Extractor`]
 //! keeps its scratch buffers, so after the first frame it allocates nothing.
 
+use crate::vision::background::{LearnedBackground, learn_background};
 use crate::vision::frames::{Frame, FrameError, FrameKind, FrameSource, beside_frames, read_image};
 use crate::vision::mask::Mask;
+use crate::vision::resize::{Shrinker, work_size};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
-/// How many frames, at most, the per-pixel median background is taken over.
-pub const MEDIAN_SAMPLE: usize = 64;
+/// How many frames, at most, a background is learned from.
+pub const BACKGROUND_SAMPLE: usize = 64;
 
 /// The largest median filter radius (a 15×15 window, whose count still fits
 /// a byte).
@@ -200,7 +202,7 @@ impl Extractor {
     }
 
     /// The image color frames are compared with (such as `background.png`,
-    /// or [`median_background`] of the frames).
+    /// or one learned from the frames).
     pub fn set_background(&mut self, background: &Frame) {
         self.background =
             Some(Background { width: background.width(), height: background.height(), rgb: background.rgb().to_vec() });
@@ -336,66 +338,76 @@ fn threshold_into(rgb: &[u8], out: &mut [u8]) {
     }
 }
 
-/// The per-pixel median of `frames`, channel by channel (the upper of the
-/// two middle values for an even count): a background wherever the person
-/// covers each pixel in fewer than half of them. All frames must be one size.
-pub fn median_background(frames: &[Frame]) -> Result<Frame, SilhouetteError> {
-    let first = frames.first().ok_or(SilhouetteError::NoFrames)?;
-    let (width, height) = (first.width(), first.height());
-    if let Some(odd) = frames.iter().find(|f| (f.width(), f.height()) != (width, height)) {
-        return Err(SilhouetteError::SizeMismatch {
-            frame: odd.label().into(),
-            width: odd.width(),
-            height: odd.height(),
-            background_width: width,
-            background_height: height,
-        });
-    }
-    // A histogram per byte would cost 256 counts each; gathering the n
-    // values and selecting the middle one costs O(n).
-    let mut values = vec![0u8; frames.len()];
-    let rgb = (0..width * height * 3)
-        .map(|i| {
-            for (v, f) in values.iter_mut().zip(frames) {
-                *v = f.rgb()[i];
-            }
-            *values.select_nth_unstable(frames.len() / 2).1
-        })
-        .collect();
-    Ok(Frame::from_rgb(format!("the median of {} frames", frames.len()), width, height, rgb))
-}
+/// How many times a learned background's noise (the median difference of a
+/// background pixel) a pixel must differ by to be the person: the sum over
+/// channels of a background pixel's differences rarely reaches three times
+/// its median.
+const NOISE_THRESHOLD: f64 = 5.0;
+/// The lowest threshold a learned background's noise may set, so a
+/// noise-free clip (rendered frames) is not cut at every rounding step.
+const MIN_THRESHOLD: u16 = 24;
+/// A shadow's color matches the background's, scaled by its darkening,
+/// within this many times the learned noise.
+const NOISE_SHADOW_CHROMA: f64 = 3.0;
+/// The darkest a shadow on a learned background may make the ground; the
+/// person's own dark clothes lie below it more often than a shadow does.
+const LEARNED_SHADOW_LOW: f32 = 0.5;
 
-/// The median background of `source`: the per-pixel median of at most
-/// [`MEDIAN_SAMPLE`] frames spread evenly over it (see
-/// [`FrameSource::sample`]).
-pub fn estimate_background(source: &FrameSource) -> Result<Frame, SilhouetteError> {
-    median_background(&source.sample(MEDIAN_SAMPLE)?)
+/// The extraction settings a learned background calls for: thresholds from
+/// its noise, shadow suppression off on greyscale frames (where a darker
+/// person and a shadow differ by nothing but texture).
+fn learned_params(learned: &LearnedBackground) -> ExtractParams {
+    let threshold = ((NOISE_THRESHOLD * learned.noise).round() as u16).clamp(MIN_THRESHOLD, 764);
+    let chroma =
+        if learned.greyscale { 0 } else { ((NOISE_SHADOW_CHROMA * learned.noise).round() as u16).clamp(1, 765) };
+    let defaults = ExtractParams::default();
+    defaults.threshold(threshold).shadow_ratio(LEARNED_SHADOW_LOW, defaults.shadow_high).shadow_chroma(chroma)
 }
 
 /// The silhouettes of a source's frames, in order, as `track` and `report`
-/// see them. Color frames are compared with the background chosen when
-/// the first one arrives: the one given, else `background.png` beside the
-/// frames (as `render --color` writes it), else the per-pixel median of the
-/// frames.
+/// see them, at a working size (see [`work_size`]). Color frames are
+/// compared with the background chosen when the first one arrives: the one
+/// given, else `background.png` beside the frames (as `render --color`
+/// writes it), else one learned from the frames themselves
+/// ([`learn_background`]), after which only the person's region (its
+/// largest coherent region and what lies near it in size) is kept.
 pub struct Silhouettes {
     source: FrameSource,
     extractor: Extractor,
+    shrinker: Shrinker,
     /// Where the frames came from, to find `background.png` beside them.
     input: PathBuf,
     background: Option<PathBuf>,
     background_used: Option<String>,
+    learned: bool,
 }
 
 impl Silhouettes {
-    /// Silhouettes of `source`, opened from `input`, with the default
+    /// Silhouettes of `source`, opened from `input`, reduced to at most
+    /// `work_width` pixels wide (0: the frames' own size), with the default
     /// extraction settings.
-    pub fn new(input: &Path, source: FrameSource, background: Option<PathBuf>) -> Silhouettes {
+    pub fn new(input: &Path, source: FrameSource, background: Option<PathBuf>, work_width: usize) -> Silhouettes {
         let extractor = Extractor::new(ExtractParams::default()).expect("the default settings are valid");
-        Silhouettes { source, extractor, input: input.to_path_buf(), background, background_used: None }
+        let size = (source.width(), source.height());
+        let shrinker = Shrinker::new(size, work_size(size.0, size.1, work_width));
+        Silhouettes {
+            source,
+            extractor,
+            shrinker,
+            input: input.to_path_buf(),
+            background,
+            background_used: None,
+            learned: false,
+        }
     }
 
     pub fn source(&self) -> &FrameSource {
         &self.source
+    }
+
+    /// The working size (width, height) the silhouettes have.
+    pub fn size(&self) -> (usize, usize) {
+        self.shrinker.size()
     }
 
     /// The background color frames were compared with, once one was.
@@ -407,7 +419,7 @@ impl Silhouettes {
     /// last frame.
     pub fn next_into(&mut self, mask: &mut Mask) -> Option<Result<(), SilhouetteError>> {
         let frame = match self.source.next_frame()? {
-            Ok(frame) => frame,
+            Ok(frame) => self.shrinker.shrink(frame),
             Err(e) => return Some(Err(e.into())),
         };
         Some(self.extract(&frame, mask))
@@ -415,15 +427,42 @@ impl Silhouettes {
 
     fn extract(&mut self, frame: &Frame, mask: &mut Mask) -> Result<(), SilhouetteError> {
         if frame.kind() == FrameKind::Color && self.background_used.is_none() {
-            let (background, from) =
-                match self.background.clone().or_else(|| beside_frames(&self.input, "background.png")) {
-                    Some(path) => (read_image(&path)?, path.display().to_string()),
-                    None => (estimate_background(&self.source)?, "the per-pixel median of the frames".to_string()),
-                };
-            self.extractor.set_background(&background);
+            let from = match self.background.clone().or_else(|| beside_frames(&self.input, "background.png")) {
+                Some(path) => {
+                    let plate = read_image(&path)?;
+                    let source = (self.source.width(), self.source.height());
+                    if (plate.width(), plate.height()) != source {
+                        return Err(SilhouetteError::SizeMismatch {
+                            frame: self.source.path().to_string(),
+                            width: source.0,
+                            height: source.1,
+                            background_width: plate.width(),
+                            background_height: plate.height(),
+                        });
+                    }
+                    self.extractor.set_background(&self.shrinker.shrink(plate));
+                    path.display().to_string()
+                }
+                None => {
+                    let sample: Vec<Frame> =
+                        self.source.sample(BACKGROUND_SAMPLE)?.into_iter().map(|f| self.shrinker.shrink(f)).collect();
+                    if sample.is_empty() {
+                        return Err(SilhouetteError::NoFrames);
+                    }
+                    let learned = learn_background(&sample);
+                    self.extractor = Extractor::new(learned_params(&learned)).expect("learned settings are in range");
+                    self.extractor.set_background(&learned.frame);
+                    self.learned = true;
+                    learned.frame.label().to_string()
+                }
+            };
             self.background_used = Some(from);
         }
-        self.extractor.extract_into(frame, mask)
+        self.extractor.extract_into(frame, mask)?;
+        if self.learned {
+            *mask = person_region(mask);
+        }
+        Ok(())
     }
 }
 
@@ -731,7 +770,7 @@ mod tests {
     }
 
     #[test]
-    fn the_median_background_of_frames_hides_a_moving_person() {
+    fn a_background_learned_from_the_frames_hides_a_moving_person() {
         let (width, height) = (160, 120);
         let background = background_rgb(width, height);
         let mut rng = ChaCha8Rng::seed_from_u64(11);
@@ -741,31 +780,17 @@ mod tests {
                 scene(&background, &person(width, height, cx), cx, 4.0, &mut rng)
             })
             .collect();
-        let median = median_background(&frames).unwrap();
-        let off = median.rgb().iter().zip(&background).filter(|&(&m, &b)| m.abs_diff(b) > 12).count();
+        let learned = learn_background(&frames);
+        let off = learned.frame.rgb().iter().zip(&background).filter(|&(&m, &b)| m.abs_diff(b) > 12).count();
         assert!(off < width * height * 3 / 200, "{off} channels far from the background");
 
-        let mut extractor = Extractor::new(ExtractParams::default()).unwrap();
-        extractor.set_background(&median);
+        let mut extractor = Extractor::new(learned_params(&learned)).unwrap();
+        extractor.set_background(&learned.frame);
         for (i, frame) in frames.iter().enumerate() {
             let truth = person(width, height, 20.0 + 15.0 * i as f64);
             let score = iou(&extractor.extract(frame).unwrap(), &truth);
             assert!(score > 0.95, "frame {i}: IoU {score}");
         }
-    }
-
-    #[test]
-    fn the_median_is_the_middle_value_of_each_channel() {
-        let frames: Vec<_> = [[10, 200, 7], [30, 100, 9], [20, 0, 8], [40, 50, 250]]
-            .iter()
-            .map(|p| Frame::from_rgb("one pixel", 1, 1, p.to_vec()))
-            .collect();
-        assert_eq!(median_background(&frames).unwrap().rgb(), &[30, 100, 9]);
-        assert_eq!(median_background(&frames[..3]).unwrap().rgb(), &[20, 100, 8]);
-        assert!(matches!(median_background(&[]), Err(SilhouetteError::NoFrames)));
-        let odd = [frames[0].clone(), Frame::from_rgb("wide", 2, 1, vec![0; 6])];
-        let message = median_background(&odd).unwrap_err().to_string();
-        assert_eq!(message, "wide: the frame is 2×1; the background is 1×1");
     }
 
     #[test]

@@ -24,6 +24,18 @@ pub fn shared_mocap_dir(corpus: &str) -> Option<PathBuf> {
     None
 }
 
+/// `../shared/video/real`, the real clips: absent outside CI, the caller
+/// skips (and says so); under CI its absence fails the test.
+pub fn real_video_dir() -> Option<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/video/real");
+    if dir.join("labels.csv").is_file() {
+        return Some(dir);
+    }
+    assert!(std::env::var_os("CI").is_none(), "{} is missing: under CI the real clips are required", dir.display());
+    eprintln!("skipping: {} is absent (under CI this fails)", dir.display());
+    None
+}
+
 /// Every `.bvh` file of the real captures, sorted by name; empty when the
 /// folder is absent outside CI.
 pub fn real_bvh_files() -> Vec<PathBuf> {

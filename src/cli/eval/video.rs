@@ -1,0 +1,251 @@
+//! `imitate eval --real-video DIR`: real clips tracked with a vocabulary
+//! learned from the real motion capture, each compared with a reference
+//! (MediaPipe Pose's masks and landmarks, as `scripts/video-reference.sh`
+//! writes them; a reference, not ground truth): the silhouettes' overlap
+//! with its masks, the 2-D agreement of the estimate with its landmarks
+//! (PCK@0.2) observing the silhouette, the keypoints or both, the activity
+//! each run credits, and its speed.
+
+use super::Work;
+use crate::cli::{arg, invoke};
+use anyhow::Context;
+use imitate::report::agreement::agreement;
+use imitate::report::eval::{Table, TimingRow};
+use imitate::report::mask_agreement::mask_agreement;
+use imitate::report::read_track;
+use imitate::report::run::Run;
+use imitate::vision::camera::Camera;
+use imitate::vision::frames::{Expect, FrameSource};
+use imitate::vision::keypoints::Keypoints;
+use imitate::vision::resize::DEFAULT_WORK_WIDTH;
+use imitate::vision::silhouette::Silhouettes;
+use serde_json::json;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Particles per primitive: the paper's sparse setting, the one the speed
+/// target is set for.
+const PARTICLES: usize = 6;
+/// The share of the reference's torso within which a point agrees.
+const PCK_THRESHOLD: f64 = 0.2;
+/// Labels that name one activity in different corpora (bandai's `punch`,
+/// m21's `box`).
+const SAME_ACTIVITY: &[&[&str]] = &[&["punch", "box"]];
+
+/// One clip of the folder's labels.csv.
+struct Clip {
+    file: PathBuf,
+    name: String,
+    activity: String,
+    camera: String,
+}
+
+/// The clips `dir/labels.csv` lists (`file,activity,camera,…`).
+fn clips(dir: &Path) -> anyhow::Result<Vec<Clip>> {
+    let labels = dir.join("labels.csv");
+    let text = std::fs::read_to_string(&labels).with_context(|| format!("{}: cannot read", labels.display()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').map(str::trim).collect();
+    if header.get(..3) != Some(&["file", "activity", "camera"][..]) {
+        anyhow::bail!("{}: the header must begin `file,activity,camera`", labels.display());
+    }
+    let mut clips = Vec::new();
+    for (i, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+        let fields: Vec<&str> = line.splitn(4, ',').map(str::trim).collect();
+        let [file, activity, camera, ..] = fields[..] else {
+            anyhow::bail!("{}: line {} has fewer than three fields", labels.display(), i + 2);
+        };
+        let path = dir.join(file);
+        if !path.is_file() {
+            anyhow::bail!("{}: line {}: {} is not there", labels.display(), i + 2, path.display());
+        }
+        let name = Path::new(file).file_stem().map_or_else(|| file.to_string(), |s| s.to_string_lossy().into());
+        clips.push(Clip { file: path, name, activity: activity.into(), camera: camera.into() });
+    }
+    Ok(clips)
+}
+
+/// A vocabulary learned from every corpus under `mocap` (each subfolder with
+/// a labels.csv), their labels joined into one file.
+pub(super) fn mocap_vocabulary(work: &Work, mocap: &Path) -> anyhow::Result<PathBuf> {
+    work.step("real video: a vocabulary of the real motion capture");
+    let folders = imitate::report::corpora::corpus_folders(mocap)?;
+    if folders.is_empty() {
+        anyhow::bail!("{}: no corpus folder (one holding BVH takes and a labels.csv)", mocap.display());
+    }
+    let mut labels = String::from("file,activity\n");
+    for folder in &folders {
+        let file = &folder.labels;
+        let text = std::fs::read_to_string(file).with_context(|| format!("{}: cannot read", file.display()))?;
+        for line in text.lines().skip(1).filter(|l| !l.trim().is_empty()) {
+            let mut fields = line.split(',');
+            if let (Some(take), Some(activity)) = (fields.next(), fields.next()) {
+                labels.push_str(&format!("{},{}\n", take.trim(), activity.trim()));
+            }
+        }
+    }
+    let labels_path = work.path("mocap-labels.csv");
+    std::fs::write(&labels_path, labels).with_context(|| format!("{}: cannot write", labels_path.display()))?;
+    let vocab = work.path("mocap.vocab");
+    let mut build: Vec<String> = vec!["vocab".into(), "build".into()];
+    build.extend(folders.iter().flat_map(|f| f.files.iter().map(|p| arg(p))));
+    build.extend(["--labels".into(), arg(&labels_path), "-o".into(), arg(&vocab)]);
+    invoke(&build)?;
+    Ok(vocab)
+}
+
+/// The real-video table and its runs' timing. `reference` holds, per clip
+/// name, `keypoints.csv` and `masks/`; without it only the activity and
+/// speed are measured.
+pub(super) fn section(
+    work: &Work,
+    dir: &Path,
+    reference: Option<&Path>,
+    vocab: &Path,
+) -> anyhow::Result<(Table, Vec<TimingRow>)> {
+    let clips = clips(dir)?;
+    let (mut rows, mut metrics, mut timing) = (Vec::new(), Vec::new(), Vec::new());
+    let particles = PARTICLES.to_string();
+    for clip in &clips {
+        let keypoints = reference.map(|r| r.join(&clip.name).join("keypoints.csv"));
+        let masks = reference.map(|r| r.join(&clip.name).join("masks"));
+        let observes: &[&str] =
+            if keypoints.is_some() { &["silhouette", "keypoints", "both"] } else { &["silhouette"] };
+        let silhouettes = match &masks {
+            Some(masks) => {
+                work.step(&format!("real video: {} silhouettes", clip.name));
+                let source = FrameSource::open(&clip.file, Expect::Auto)?;
+                let mut extracted = Silhouettes::new(&clip.file, source, None, DEFAULT_WORK_WIDTH);
+                Some(mask_agreement(&mut extracted, masks)?.mean_iou)
+            }
+            None => None,
+        };
+        let (mut pck, mut credited, mut failed) = (BTreeMap::new(), None, BTreeMap::new());
+        for &observe in observes {
+            work.step(&format!("real video: {} ({observe})", clip.name));
+            let out = work.path(&format!("runs/real-{}-{observe}", clip.name));
+            let mut args = vec!["track".to_string(), arg(&clip.file), "--vocab".into(), arg(vocab)];
+            args.extend(["-o".into(), arg(&out), "--particles".into(), particles.clone(), "--feedback".into()]);
+            args.extend(["--force".into(), "--seed".into(), work.seeds[0].to_string()]);
+            if let Some(k) = &keypoints {
+                args.extend(["--keypoints".into(), arg(k), "--observe".into(), observe.into()]);
+            }
+            // A clip the tracker refuses is a row that says why, not the
+            // end of the report.
+            if let Err(e) = invoke(&args) {
+                failed.insert(observe, format!("{e:#}"));
+                continue;
+            }
+            let run = Run::read(&out)?;
+            timing.push(TimingRow {
+                trial: "Real video".into(),
+                series: observe.into(),
+                x: clip.name.clone(),
+                frames_per_second: run.summary.timing.frames_per_second,
+                evaluations_per_frame: run.summary.likelihood_evaluations_per_frame,
+            });
+            if let Some(k) = &keypoints {
+                let camera = Camera::read(&out.join("camera.json"))?;
+                let mut reference = Keypoints::read(k)?;
+                reference.fit_to(camera.width(), camera.height())?;
+                let track = read_track(&out.join("frames.csv"))?;
+                pck.insert(observe, agreement(&track, &camera, &reference, PCK_THRESHOLD)?.pck_mirror);
+            }
+            if observe == "silhouette" {
+                credited = Some(credit(&run, &clip.activity));
+            }
+        }
+        let cell = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.2}"));
+        rows.push(vec![
+            clip.name.clone(),
+            clip.activity.clone(),
+            clip.camera.clone(),
+            cell(silhouettes),
+            cell(pck.get("silhouette").copied()),
+            cell(pck.get("keypoints").copied()),
+            cell(pck.get("both").copied()),
+            credited.as_ref().map_or("n/a".into(), |c| format!("{:.0}%", 100.0 * c.labelled)),
+            match (&credited, failed.get("silhouette")) {
+                (Some(c), _) => c.top.clone(),
+                (None, Some(why)) => format!("not tracked: {why}"),
+                (None, None) => "n/a".into(),
+            },
+        ]);
+        metrics.push(json!({
+            "clip": clip.name, "activity": clip.activity, "camera": clip.camera,
+            "silhouette_iou": silhouettes,
+            "pck_silhouette": pck.get("silhouette"), "pck_keypoints": pck.get("keypoints"), "pck_both": pck.get("both"),
+            "labelled_activity_share": credited.as_ref().map(|c| c.labelled),
+            "frames_named": credited.as_ref().map(|c| c.frames),
+            "credited": credited.as_ref().map(|c| &c.shares),
+            "not_tracked": failed,
+        }));
+    }
+    let table = Table {
+        key: "real_video".into(),
+        title: "Real video".into(),
+        about: format!(
+            "The clips of {dir} tracked with no option but the vocabulary (learned from the real motion capture), \
+             {PARTICLES} particles per primitive, eq. 10. Silhouettes: mean IoU with MediaPipe Pose's person masks \
+             at the working size. PCK@0.2: the share of shoulders, elbows, wrists and hips within 0.2 torso lengths \
+             of MediaPipe's landmarks (left and right swapped where that agrees better), observing the silhouette, \
+             the keypoints or both. MediaPipe is a reference, not ground truth. Labelled activity: the share of the \
+             silhouette run's frames naming a primitive whose label is the clip's (punch and box count as one); \
+             most named: the labels credited most.",
+            dir = dir.display()
+        ),
+        columns: [
+            "clip",
+            "activity",
+            "camera",
+            "silhouette IoU",
+            "PCK silhouette",
+            "PCK keypoints",
+            "PCK both",
+            "labelled activity",
+            "most named",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows,
+        metrics: metrics.into(),
+    };
+    Ok((table, timing))
+}
+
+/// What a run credits: the share of its frames naming an activity that
+/// name the clip's, and every label's share.
+struct Credit {
+    frames: usize,
+    labelled: f64,
+    shares: BTreeMap<String, f64>,
+    top: String,
+}
+
+fn credit(run: &Run, activity: &str) -> Credit {
+    let label_of: BTreeMap<&str, &str> = run
+        .primitives
+        .labels
+        .iter()
+        .map(|(name, label)| (name.as_str(), label.as_deref().unwrap_or(name.as_str())))
+        .collect();
+    let same = |label: &str| {
+        label == activity || SAME_ACTIVITY.iter().any(|group| group.contains(&label) && group.contains(&activity))
+    };
+    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
+    for named in run.track.activity.iter().flatten() {
+        *counts.entry(label_of.get(named.as_str()).copied().unwrap_or(named).to_string()).or_default() += 1;
+    }
+    let frames: usize = counts.values().sum();
+    let share = |n: usize| if frames == 0 { 0.0 } else { n as f64 / frames as f64 };
+    let labelled = share(counts.iter().filter(|(label, _)| same(label)).map(|(_, &n)| n).sum());
+    let mut ranked: Vec<(&String, &usize)> = counts.iter().collect();
+    ranked.sort_by(|a, b| b.1.cmp(a.1).then(a.0.cmp(b.0)));
+    let top = ranked.iter().take(2).map(|(l, n)| format!("{l} {:.0}%", 100.0 * share(**n))).collect::<Vec<_>>();
+    Credit {
+        frames,
+        labelled,
+        shares: counts.iter().map(|(l, &n)| (l.clone(), share(n))).collect(),
+        top: top.join(", "),
+    }
+}
