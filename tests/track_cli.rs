@@ -207,6 +207,7 @@ fn bad_input_is_refused_with_nothing_written() {
     let vocab = vocab.to_str().unwrap();
     refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--particles", "0"], 2, "--particles 0");
     refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--lookahead", "0"], 2, "--lookahead 0");
+    refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--work-size", "8"], 2, "--work-size 8");
     refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--height", "0.5"], 2, "--height 0.5");
     refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--fps", "0"], 2, "--fps 0");
     let both = ["track", frames, "--vocab", vocab, "-o", "out", "--height", "1.7", "--no-calibrate"];
@@ -434,4 +435,45 @@ fn the_primitives_filters_halve_the_error_of_the_full_space_baseline_at_the_same
     let (ours, theirs) =
         (upper_body_mm(tmp.path(), "primitives", "video"), upper_body_mm(tmp.path(), "baseline", "video"));
     assert!(2.0 * ours < theirs, "primitives {ours:.1} mm, baseline {theirs:.1} mm");
+}
+
+#[test]
+fn color_frames_are_tracked_at_the_working_size_and_their_silhouettes_scored_against_masks() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let take = shipped("mocap/wave-h.bvh");
+    let take = take.to_str().unwrap();
+    let vocab = shipped("vocab/default.vocab");
+    let vocab = vocab.to_str().unwrap();
+    // The same take in color at 320×240 and as clean silhouettes, the
+    // reference masks.
+    ok(run(dir, &["render", take, "-o", "color", "--color", "--size", "320x240"], "2"));
+    ok(run(dir, &["render", take, "-o", "clean", "--size", "320x240"], "2"));
+    let args = ["track", "color/frames", "--vocab", vocab, "-o", "run", "--work-size", "160"];
+    ok(run(dir, &args, "2"));
+    let summary = summary_without_timing(&dir.join("run"));
+    assert_eq!(summary["work_size"], serde_json::json!([160, 120]));
+    // The camera stays in the frames' own pixels: the one they were rendered by.
+    let camera =
+        |path: &str| -> serde_json::Value { serde_json::from_slice(&fs::read(dir.join(path)).unwrap()).unwrap() };
+    assert_eq!(camera("run/camera.json"), camera("color/camera.json"));
+    ok(run(dir, &["score", "run", "--masks", "clean/frames"], "2"));
+    let agreement = camera("run/silhouettes.json");
+    assert_eq!(agreement["work_size"], serde_json::json!([160, 120]));
+    let iou = agreement["mean_iou"].as_f64().unwrap();
+    assert!(iou > 0.95, "IoU {iou} against the clean silhouettes");
+    // A reference with a mask more than the frames describes another video.
+    let longer = dir.join("longer");
+    fs::create_dir(&longer).unwrap();
+    let mut masks: Vec<PathBuf> = fs::read_dir(dir.join("clean/frames")).unwrap().map(|e| e.unwrap().path()).collect();
+    masks.sort();
+    for (i, mask) in masks.iter().enumerate() {
+        fs::copy(mask, longer.join(format!("{i:06}.png"))).unwrap();
+    }
+    fs::copy(&masks[0], longer.join(format!("{:06}.png", masks.len()))).unwrap();
+    let out = run(dir, &["score", "run", "--masks", "longer", "-o", "longer.json"], "2");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("masks, but") && err.contains("has only"), "{err}");
+    assert!(!dir.join("longer.json").exists());
 }

@@ -273,7 +273,7 @@ fn strip(run_dir: &Path, video: &Video, name: &str, caption: &str) -> anyhow::Re
     let truth = read_track(&video.truth)?;
     let camera = tracked_camera(&run)?;
     let picks = pick_frames(run.track.frame.len(), 8);
-    let observed = silhouettes(&video.frames, run.track.frame.len(), &picks, camera.width())?;
+    let observed = silhouettes(&video.frames, run.track.frame.len(), &picks, camera.width(), None)?;
     let png = filmstrip(&camera, &run.track, Some(&truth), &picks, &observed);
     Ok(Picture { name: name.into(), png, svg: None, caption: caption.into() })
 }

@@ -3,14 +3,14 @@
 use super::{Global, Outcome, UsageError, note, refuse_nonempty};
 use anyhow::{Context, bail};
 use imitate::fsutil::write_dir_atomic;
-use imitate::report::filmstrip::{MAX_FRAMES, pick_frames};
+use imitate::report::filmstrip::{MAX_FRAMES, Observed, pick_frames};
 use imitate::report::imitation::read_imitation;
 use imitate::report::metrics::score;
 use imitate::report::page::{Truth, run_report};
 use imitate::report::read_track;
 use imitate::report::run::Run;
 use imitate::vision::camera::Camera;
-use imitate::vision::frames::{Expect, FrameSource};
+use imitate::vision::frames::{Expect, FrameKind, FrameSource};
 use imitate::vision::mask::Mask;
 use imitate::vision::silhouette::Silhouettes;
 use std::path::{Path, PathBuf};
@@ -52,14 +52,17 @@ pub struct Args {
     pub force: bool,
 }
 
-/// The silhouettes of frames `picks` of `input`, which must hold `frames`
-/// frames, at most `work_width` pixels wide (as `track --work-size`).
+/// What the tracker saw of frames `picks` of `input` (which must hold
+/// `frames` frames), at most `work_width` pixels wide (as `track
+/// --work-size`), color frames against `background` when the run was given
+/// one: the silhouettes, and the images of color frames.
 pub(super) fn silhouettes(
     input: &Path,
     frames: usize,
     picks: &[usize],
     work_width: usize,
-) -> anyhow::Result<Vec<Mask>> {
+    background: Option<PathBuf>,
+) -> anyhow::Result<Vec<Observed>> {
     let source = FrameSource::open(input, Expect::Auto)?;
     if let Some(n) = source.frame_count().filter(|&n| n != frames) {
         bail!(
@@ -67,15 +70,16 @@ pub(super) fn silhouettes(
             input.display()
         );
     }
-    let mut silhouettes = Silhouettes::new(input, source, None, work_width);
+    let mut silhouettes = Silhouettes::new(input, source, background, work_width);
     let (mut mask, mut out, mut k) = (Mask::new(1, 1), Vec::new(), 0);
     while out.len() < picks.len() {
-        match silhouettes.next_into(&mut mask) {
+        let frame = match silhouettes.next_seen(&mut mask) {
             Some(r) => r?,
             None => bail!("{}: ends after {k} frames, but the run tracked {frames}", input.display()),
-        }
+        };
         if picks[out.len()] == k {
-            out.push(mask.clone());
+            let image = (frame.kind() == FrameKind::Color).then_some(frame);
+            out.push(Observed { mask: mask.clone(), image });
         }
         k += 1;
     }
@@ -107,11 +111,11 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let metrics = truth.as_ref().map(|t| score(&run.track, t, &run.primitives, args.settle)).transpose()?;
     let input = args.frames.clone().unwrap_or_else(|| PathBuf::from(&run.summary.input));
     let picks = pick_frames(run.track.frame.len(), MAX_FRAMES);
-    let observed =
-        silhouettes(&input, run.track.frame.len(), &picks, camera.width()).with_context(|| match &args.frames {
-            Some(_) => "--frames".to_string(),
-            None => format!("the frames {} names (pass --frames if they moved)", summary.display()),
-        })?;
+    let observed = silhouettes(&input, run.track.frame.len(), &picks, camera.width(), run.summary.background_plate())
+        .with_context(|| match &args.frames {
+        Some(_) => "--frames".to_string(),
+        None => format!("the frames {} names (pass --frames if they moved)", summary.display()),
+    })?;
     let truth_view = truth.as_ref().zip(metrics.as_ref()).map(|(track, metrics)| Truth { track, metrics });
     let imitation = args.execution.as_deref().map(|dir| read_imitation(dir, &run.track)).transpose()?;
     let mut files = run_report(&run, truth_view, imitation.as_ref(), &camera, &picks, &observed);

@@ -192,6 +192,13 @@ fn params(args: &Args, fps: f64) -> Result<TrackParams, UsageError> {
     if args.lookahead == 0 {
         return Err(UsageError("--lookahead 0: the bending cone needs at least 1 prediction".into()));
     }
+    if (1..MIN_WORK_WIDTH).contains(&args.work_size) {
+        return Err(UsageError(format!(
+            "--work-size {}: frames reduced below {MIN_WORK_WIDTH} pixels wide show no limbs; give {MIN_WORK_WIDTH} \
+             or more, or 0 for the frames' own size",
+            args.work_size
+        )));
+    }
     if let Some(fps) = args.fps
         && !(fps.is_finite() && fps > 0.0 && fps <= 1000.0)
     {
@@ -243,6 +250,10 @@ fn given_camera(args: &Args, source: &FrameSource) -> anyhow::Result<Option<(Cam
     source.check_size(camera.width(), camera.height())?;
     Ok(Some((camera, from)))
 }
+
+/// The narrowest working width: a standing person is then about 10 pixels
+/// tall, a limb a fraction of one.
+const MIN_WORK_WIDTH: usize = 32;
 
 /// The width silhouettes are reduced to for comparing cameras.
 const PROBE_WIDTH: usize = 160;

@@ -1,11 +1,13 @@
 //! Filmstrips like the paper's Figures 6 and 7: for a few frames, the
-//! observed silhouette with the estimated body drawn over it from the
-//! camera, and the estimate seen from above; the true body too, when known.
+//! observed silhouette (over the camera's own image, for color frames) with
+//! the estimated body drawn over it from the camera, and the estimate seen
+//! from above; the true body too, when known.
 
 use super::metrics::Track;
 use super::plot::{color, encode_png, register_font};
 use crate::mocap::body::{JOINTS, Joint};
 use crate::vision::camera::Camera;
+use crate::vision::frames::Frame;
 use crate::vision::mask::Mask;
 use glam::DVec3;
 use plotters::coord::Shift;
@@ -25,6 +27,14 @@ const TOP_VIEW_M: f64 = 2.0;
 const GAP: u32 = 6;
 const CAPTION: u32 = 18;
 
+/// What the tracker saw of one frame: its silhouette and, for a color frame,
+/// the image it came from, both at the size the run tracked at.
+#[derive(Clone, Debug)]
+pub struct Observed {
+    pub mask: Mask,
+    pub image: Option<Frame>,
+}
+
 /// `count` frames of `frames`, spread evenly, first and last included.
 pub fn pick_frames(frames: usize, count: usize) -> Vec<usize> {
     match (frames, count.min(frames)) {
@@ -34,15 +44,16 @@ pub fn pick_frames(frames: usize, count: usize) -> Vec<usize> {
     }
 }
 
-/// The filmstrip of `picks` (rows of `estimate`), with `observed[k]` the
-/// silhouette of frame `picks[k]` as `camera` saw it, as PNG bytes. The
-/// estimate is blue and thick, the truth orange and thin.
+/// The filmstrip of `picks` (rows of `estimate`), with `observed[k]` what
+/// `camera` saw of frame `picks[k]`, as PNG bytes. A silhouette is drawn
+/// gray on white; a color frame as its image, faded, with the silhouette's
+/// outline. The estimate is blue and thick, the truth orange and thin.
 pub fn filmstrip(
     camera: &Camera,
     estimate: &Track,
     truth: Option<&Track>,
     picks: &[usize],
-    observed: &[Mask],
+    observed: &[Observed],
 ) -> Vec<u8> {
     register_font();
     let scale = if camera.width() <= 200 { 2 } else { 1 };
@@ -58,14 +69,28 @@ pub fn filmstrip(
         let (block, column) = ((k / COLUMNS) as u32, (k % COLUMNS) as u32);
         (GAP + column * (tw + GAP), block * block_height + CAPTION + GAP + row * (th + GAP))
     };
-    for (k, mask) in observed.iter().enumerate() {
+    for (k, seen) in observed.iter().enumerate() {
         let (x0, y0) = origin(k, 0);
         for y in 0..th {
             for x in 0..tw {
-                let inside = mask.get((x / scale) as usize, (y / scale) as usize);
-                let v = if inside { 190 } else { 246 };
+                let (u, v) = ((x / scale) as usize, (y / scale) as usize);
+                let inside = seen.mask.get(u, v);
                 let at = (((y0 + y) * width + x0 + x) * 3) as usize;
-                rgb[at..at + 3].fill(v);
+                let pixel = &mut rgb[at..at + 3];
+                match &seen.image {
+                    None => pixel.fill(if inside { 190 } else { 246 }),
+                    Some(image) => {
+                        // Faded toward white so the skeleton stands out; the
+                        // silhouette's edge in black.
+                        let source = &image.rgb()[3 * (v * image.width() + u)..][..3];
+                        for (out, &c) in pixel.iter_mut().zip(source) {
+                            *out = ((u16::from(c) + 2 * 255) / 3) as u8;
+                        }
+                        if inside && on_edge(&seen.mask, u, v) {
+                            pixel.fill(40);
+                        }
+                    }
+                }
             }
         }
     }
@@ -107,6 +132,17 @@ pub fn filmstrip(
         root.present().expect("drawing into memory cannot fail");
     }
     encode_png(width, height, rgb)
+}
+
+/// Whether the set pixel (u, v) of `mask` has an unset 4-neighbour or lies
+/// on the image's edge.
+fn on_edge(mask: &Mask, u: usize, v: usize) -> bool {
+    let (w, h) = (mask.width(), mask.height());
+    u == 0
+        || v == 0
+        || u + 1 == w
+        || v + 1 == h
+        || [(u - 1, v), (u + 1, v), (u, v - 1), (u, v + 1)].iter().any(|&(x, y)| !mask.get(x, y))
 }
 
 fn draw<DB: DrawingBackend, E>(root: &DrawingArea<DB, Shift>, element: &E)

@@ -3,13 +3,12 @@
 //! known, and a filmstrip.
 
 use super::figures;
-use super::filmstrip::filmstrip;
+use super::filmstrip::{Observed, filmstrip};
 use super::html::Page;
 use super::imitation::Imitation;
 use super::metrics::{Metrics, Track};
 use super::run::Run;
 use crate::vision::camera::Camera;
-use crate::vision::mask::Mask;
 
 /// A file of a report: its name in the report's folder and its bytes.
 pub type File = (String, Vec<u8>);
@@ -60,7 +59,7 @@ pub fn score_rows(m: &Metrics) -> Vec<Vec<String>> {
 }
 
 /// The report of `run`: `index.html` and its pictures (PNG and SVG),
-/// with `observed[k]` the silhouette of frame `picks[k]`, and how the
+/// with `observed[k]` what the tracker saw of frame `picks[k]`, and how the
 /// humanoid played its trajectory when it did.
 pub fn run_report(
     run: &Run,
@@ -68,7 +67,7 @@ pub fn run_report(
     imitation: Option<&Imitation>,
     camera: &Camera,
     picks: &[usize],
-    observed: &[Mask],
+    observed: &[Observed],
 ) -> Vec<File> {
     let mut files: Vec<File> = Vec::new();
     let mut page = Page::new(&format!("Tracking report: {}", run.dir.display()));
@@ -112,9 +111,14 @@ pub fn run_report(
     if !picks.is_empty() {
         page.heading("Filmstrip");
         let strip = filmstrip(camera, &run.track, truth.as_ref().map(|t| t.track), picks, observed);
-        page.image(&strip, "image/png", "filmstrip",
-            "Top: the observed silhouette (gray) with the estimate (blue) and the truth (orange, when known) drawn from \
-             the camera. Bottom: the same seen from above, the camera's side down.");
+        page.image(
+            &strip,
+            "image/png",
+            "filmstrip",
+            "Top: the observed silhouette (gray; outlined in black over the camera's image for color frames) with the \
+             estimate (blue) and the truth (orange, when known) drawn from the camera. Bottom: the same seen from \
+             above, the camera's side down.",
+        );
         files.push(("filmstrip.png".into(), strip));
     }
     if let Some(imitation) = imitation {

@@ -117,6 +117,12 @@ impl Frame {
         Frame { label: label.into(), width, height, kind, rgb }
     }
 
+    /// The same pixels taken as `kind` (as a source's rule decides it).
+    pub(crate) fn with_kind(mut self, kind: FrameKind) -> Frame {
+        self.kind = kind;
+        self
+    }
+
     /// The file, or the video and frame number, the frame came from.
     pub fn label(&self) -> &str {
         &self.label

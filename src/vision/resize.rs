@@ -6,7 +6,7 @@
 //! source is at `u · width' / width` in the reduced frame), which keeps thin
 //! limbs as partial pixels instead of dropping them as point sampling would.
 
-use crate::vision::frames::Frame;
+use crate::vision::frames::{Frame, FrameKind};
 use crate::vision::mask::Mask;
 
 /// The working width when none is given: a person filling a third of the
@@ -81,7 +81,9 @@ impl Shrinker {
         self.to
     }
 
-    /// `frame` reduced; a frame already of the reduced size is returned as it is.
+    /// `frame` reduced, of its kind: a silhouette frame stays black and
+    /// white (a pixel is the person when at least half its area was); a
+    /// frame already of the reduced size is returned as it is.
     pub fn shrink(&mut self, frame: Frame) -> Frame {
         if (frame.width(), frame.height()) == self.to {
             return frame;
@@ -111,7 +113,13 @@ impl Shrinker {
                 *o = ((sum + (1 << 31)) >> 32).min(255) as u8;
             }
         }
-        Frame::from_rgb(frame.label().to_string(), to_width, to_height, reduced)
+        if frame.kind() == FrameKind::Silhouette {
+            for pixel in reduced.chunks_exact_mut(3) {
+                let person = pixel.iter().map(|&c| u16::from(c)).sum::<u16>() >= 3 * 128;
+                pixel.fill(if person { 255 } else { 0 });
+            }
+        }
+        Frame::from_rgb(frame.label().to_string(), to_width, to_height, reduced).with_kind(frame.kind())
     }
 }
 
@@ -147,6 +155,19 @@ mod tests {
     }
 
     #[test]
+    fn a_reduced_frame_keeps_its_kind() {
+        // A silhouette's edge falls between pixels: it stays black and white.
+        let edge: Vec<u8> = (0..6 * 2).flat_map(|i| [if i % 6 < 3 { 255 } else { 0 }; 3]).collect();
+        let silhouette = Frame::from_rgb("s", 6, 2, edge);
+        let reduced = Shrinker::new((6, 2), (4, 1)).shrink(silhouette);
+        assert_eq!(reduced.kind(), FrameKind::Silhouette);
+        assert_eq!(reduced.rgb(), &[255, 255, 255, 255, 255, 255, 0, 0, 0, 0, 0, 0]);
+        // A color frame that reduces to black and white is still color.
+        let color = Frame::from_rgb("c", 2, 1, vec![0, 0, 0, 255, 255, 255]).with_kind(FrameKind::Color);
+        assert_eq!(Shrinker::new((2, 1), (1, 1)).shrink(color).kind(), FrameKind::Color);
+    }
+
+    #[test]
     fn halving_averages_each_two_by_two_block() {
         let rgb: Vec<u8> = (0..4 * 2).flat_map(|i| [i as u8 * 10, 200, 7]).collect();
         let mut shrinker = Shrinker::new((4, 2), (2, 1));
@@ -166,7 +187,7 @@ mod tests {
         for y in 0..3 {
             rgb[y * 15..y * 15 + 3].copy_from_slice(&[255, 255, 255]);
         }
-        let edge = shrinker.shrink(Frame::from_rgb("t", 5, 3, rgb));
+        let edge = shrinker.shrink(Frame::from_rgb("t", 5, 3, rgb).with_kind(FrameKind::Color));
         assert_eq!(edge.rgb()[0], 102);
         assert_eq!(edge.rgb()[3], 0);
     }

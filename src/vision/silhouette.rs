@@ -418,11 +418,17 @@ impl Silhouettes {
     /// The next frame's silhouette, written into `mask`; `None` after the
     /// last frame.
     pub fn next_into(&mut self, mask: &mut Mask) -> Option<Result<(), SilhouetteError>> {
+        self.next_seen(mask).map(|seen| seen.map(drop))
+    }
+
+    /// [`Silhouettes::next_into`], giving the frame (at the working size)
+    /// the silhouette came from.
+    pub fn next_seen(&mut self, mask: &mut Mask) -> Option<Result<Frame, SilhouetteError>> {
         let frame = match self.source.next_frame()? {
             Ok(frame) => self.shrinker.shrink(frame),
             Err(e) => return Some(Err(e.into())),
         };
-        Some(self.extract(&frame, mask))
+        Some(self.extract(&frame, mask).map(|()| frame))
     }
 
     fn extract(&mut self, frame: &Frame, mask: &mut Mask) -> Result<(), SilhouetteError> {
