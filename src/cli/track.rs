@@ -433,6 +433,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let mut given = given_camera(&args, &source)?;
     let frame_size = (source.width(), source.height());
     let work = work_size(frame_size.0, frame_size.1, args.work_size);
+    // A given camera is written back as it was given, byte for byte.
+    let given_as_is = given.as_ref().map(|(camera, _)| camera.clone());
     if let Some((camera, _)) = &mut given {
         *camera = camera.resized(work.0, work.1);
     }
@@ -459,7 +461,6 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     // The timing includes estimating the camera.
     let started = Instant::now();
     let mut silhouettes = Silhouettes::new(&args.input, source, args.background.clone(), args.work_size);
-
     let mut pending = Vec::new();
     let (camera, camera_estimate) = match &given {
         Some((camera, _)) => (camera.clone(), None),
@@ -538,7 +539,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let seconds = started.elapsed().as_secs_f64();
     let evaluations = follower.evaluations() + camera_estimate.as_ref().map_or(0, |e| e.evaluations);
     // The camera in the frames' own pixels, as the user's files are.
-    let seen_camera = camera.resized(frame_size.0, frame_size.1);
+    let seen_camera = given_as_is.unwrap_or_else(|| camera.resized(frame_size.0, frame_size.1));
     let motion = Motion { body: follower.body().clone(), frame_time_s: 1.0 / fps, poses };
     let summary = serde_json::json!({
         "input": args.input.display().to_string(),

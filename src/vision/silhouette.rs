@@ -439,7 +439,7 @@ impl Silhouettes {
                     let source = (self.source.width(), self.source.height());
                     if (plate.width(), plate.height()) != source {
                         return Err(SilhouetteError::SizeMismatch {
-                            frame: self.source.path().to_string(),
+                            frame: format!("{} against {}", self.source.path(), path.display()),
                             width: source.0,
                             height: source.1,
                             background_width: plate.width(),
