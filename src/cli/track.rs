@@ -564,6 +564,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         "fps_from": rate_from,
         "frames": k,
         "coasted_frames": coasted,
+        "unusable_silhouettes": silhouettes.unusable(),
         "likelihood_evaluations": evaluations,
         "likelihood_evaluations_per_frame": evaluations as f64 / k as f64,
         "timing": { "seconds": seconds, "frames_per_second": k as f64 / seconds },

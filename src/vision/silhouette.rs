@@ -370,7 +370,9 @@ fn learned_params(learned: &LearnedBackground) -> ExtractParams {
 /// given, else `background.png` beside the frames (as `render --color`
 /// writes it), else one learned from the frames themselves
 /// ([`learn_background`]), after which only the person's region (its
-/// largest coherent region and what lies near it in size) is kept.
+/// largest coherent region and what lies near it in size) is kept. A color
+/// frame whose silhouette covers more than [`MAX_PERSON_SHARE`] of it gives
+/// an empty one.
 pub struct Silhouettes {
     source: FrameSource,
     extractor: Extractor,
@@ -380,6 +382,7 @@ pub struct Silhouettes {
     background: Option<PathBuf>,
     background_used: Option<String>,
     learned: bool,
+    unusable: usize,
 }
 
 impl Silhouettes {
@@ -398,6 +401,7 @@ impl Silhouettes {
             background,
             background_used: None,
             learned: false,
+            unusable: 0,
         }
     }
 
@@ -468,9 +472,28 @@ impl Silhouettes {
         if self.learned {
             *mask = person_region(mask);
         }
+        // Most of the frame changed: a cut to another scene, a camera that
+        // moved or the light switched, not a person.
+        if frame.kind() == FrameKind::Color
+            && mask.count() as f64 > MAX_PERSON_SHARE * (mask.width() * mask.height()) as f64
+        {
+            mask.clear();
+            self.unusable += 1;
+        }
         Ok(())
     }
+
+    /// How many color frames so far changed over more than
+    /// [`MAX_PERSON_SHARE`] of their area and were given as empty.
+    pub fn unusable(&self) -> usize {
+        self.unusable
+    }
 }
+
+/// The largest share of a color frame a silhouette may cover; beyond it the
+/// frame is taken to show no person (an empty silhouette, which the tracker
+/// coasts through).
+pub const MAX_PERSON_SHARE: f64 = 0.5;
 
 /// Scratch rows of the binary median filter.
 #[derive(Debug, Default)]
