@@ -478,6 +478,13 @@ fn color_frames_are_tracked_at_the_working_size_and_their_silhouettes_scored_aga
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("masks, but") && err.contains("has only"), "{err}");
     assert!(!dir.join("longer.json").exists());
+    // Masks of another size than the frames.
+    ok(run(dir, &["render", take, "-o", "small"], "2"));
+    let out = run(dir, &["score", "run", "--masks", "small/frames", "-o", "small.json"], "2");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("the masks are 160×120") && err.contains("320×240"), "{err}");
+    assert!(!dir.join("small.json").exists());
 }
 
 #[test]

@@ -38,6 +38,8 @@ pub struct MaskAgreement {
 pub enum MaskAgreementError {
     #[error("{reference}: {listed} masks, but {frames} has only {count} frames: they must describe the same video")]
     FrameCount { reference: String, listed: usize, frames: String, count: usize },
+    #[error("{reference}: the masks are {width}×{height}, but the frames of {frames} are {frame_width}×{frame_height}")]
+    Size { reference: String, width: usize, height: usize, frames: String, frame_width: usize, frame_height: usize },
     #[error("{reference}: every mask is empty, so there is nobody to compare with")]
     NoPerson { reference: String },
     #[error(transparent)]
@@ -65,6 +67,17 @@ pub fn mask_agreement(silhouettes: &mut Silhouettes, reference: &Path) -> Result
     let reference_name = reference.display().to_string();
     let frames_from = silhouettes.source().path().to_string();
     let source = FrameSource::open(reference, Expect::Silhouettes).map_err(SilhouetteError::from)?;
+    let seen = silhouettes.source();
+    if (source.width(), source.height()) != (seen.width(), seen.height()) {
+        return Err(MaskAgreementError::Size {
+            reference: reference_name,
+            width: source.width(),
+            height: source.height(),
+            frames: frames_from,
+            frame_width: seen.width(),
+            frame_height: seen.height(),
+        });
+    }
     let mut masks = Silhouettes::new(reference, source, None, silhouettes.size().0);
     let (mut ours, mut theirs) = (Mask::new(1, 1), Mask::new(1, 1));
     let (mut frames, mut empty_reference, mut false_people, mut count) = (0, 0, 0, 0);
