@@ -33,13 +33,6 @@ fn masks(folder: &Path, expect: Expect, extractor: &mut Extractor) -> Vec<Mask> 
     source.map(|frame| extractor.extract(&frame.unwrap()).unwrap()).collect()
 }
 
-fn iou(a: &Mask, b: &Mask) -> f64 {
-    let pairs = || a.pixels().iter().zip(b.pixels());
-    let both = pairs().filter(|(p, q)| **p == 1 && **q == 1).count();
-    let either = pairs().filter(|(p, q)| **p == 1 || **q == 1).count();
-    if either == 0 { 1.0 } else { both as f64 / either as f64 }
-}
-
 /// (mean, worst) IoU over the frames of `take` rendered in color at `noise`
 /// and extracted against the rendered background.
 fn recovery(take: &Path, camera: &str, noise: &str, work: &Path) -> (f64, f64) {
@@ -54,7 +47,7 @@ fn recovery(take: &Path, camera: &str, noise: &str, work: &Path) -> (f64, f64) {
     extractor.set_background(&read_image(&noisy.join("background.png")).unwrap());
     let found = masks(&noisy.join("color"), Expect::Color, &mut extractor);
     assert_eq!(truth.len(), found.len());
-    let scores: Vec<f64> = truth.iter().zip(&found).map(|(t, f)| iou(t, f)).collect();
+    let scores: Vec<f64> = truth.iter().zip(&found).map(|(t, f)| t.iou(f)).collect();
     let mean = scores.iter().sum::<f64>() / scores.len() as f64;
     let worst = scores.iter().copied().fold(1.0, f64::min);
     eprintln!("{name} at {noise}: mean IoU {mean:.3}, worst frame {worst:.3}, {} frames", scores.len());

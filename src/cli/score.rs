@@ -1,12 +1,11 @@
 //! `imitate score`: a tracking run against the truth of its video.
 
-use super::report::tracked_camera;
 use super::{Global, Outcome, UsageError, note};
 use anyhow::Context;
 use imitate::fsutil::write_atomic;
-use imitate::report::agreement::agreement;
-use imitate::report::mask_agreement::mask_agreement;
-use imitate::report::metrics::{Metrics, score};
+use imitate::report::agreement::{Agreement, PCK_THRESHOLD, agreement};
+use imitate::report::mask_agreement::{MaskAgreement, mask_agreement};
+use imitate::report::metrics::{Metrics, Track, score};
 use imitate::report::run::Run;
 use imitate::report::{read_primitives, read_track};
 use imitate::vision::camera::Camera;
@@ -14,7 +13,7 @@ use imitate::vision::frames::{Expect, FrameSource};
 use imitate::vision::keypoints::Keypoints;
 use imitate::vision::silhouette::Silhouettes;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Score a tracking run against the ground truth of its video: joint
 /// position errors (mm), limb direction errors (degrees), how often the
@@ -59,23 +58,17 @@ pub struct Args {
     pub settle: f64,
 }
 
-/// The share of the reference's torso within which a point agrees.
-const PCK_THRESHOLD: f64 = 0.2;
-
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     if !(args.settle.is_finite() && args.settle >= 0.0) {
         return Err(UsageError(format!("--settle {}: must be a number of seconds, 0 or more", args.settle)).into());
     }
     let estimate = read_track(&args.run.join("frames.csv"))?;
-    let (json, output, line) = match (&args.truth, &args.keypoints) {
-        _ if args.masks.is_some() => {
-            let masks = args.masks.as_deref().expect("matched");
+    let (json, output, line) = match (&args.truth, &args.keypoints, &args.masks) {
+        (_, _, Some(masks)) => {
             let run = Run::read(&args.run)?;
-            let camera = tracked_camera(&run)?;
             let input = PathBuf::from(&run.summary.input);
-            let source = FrameSource::open(&input, Expect::Auto)?;
-            let mut silhouettes = Silhouettes::new(&input, source, run.summary.background_plate(), camera.width());
-            let agreement = mask_agreement(&mut silhouettes, masks)?;
+            let work_width = run.summary.work_size.map_or(0, |[width, _]| width);
+            let agreement = silhouette_agreement(&input, run.summary.background_plate(), work_width, masks)?;
             let output = args.output.clone().unwrap_or_else(|| args.run.join("silhouettes.json"));
             let line = format!(
                 "{} frames at {}×{}: mean IoU {:.3} (lowest {:.3}), recall {:.3}, precision {:.3} → {}",
@@ -90,7 +83,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             );
             (serde_json::to_string_pretty(&agreement), output, line)
         }
-        (Some(truth), _) => {
+        (Some(truth), _, None) => {
             let truth = read_track(truth)?;
             let primitives = read_primitives(&args.run.join("summary.json"))?;
             let metrics = score(&estimate, &truth, &primitives, args.settle)?;
@@ -98,12 +91,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             let line = summary(&metrics, &output.display().to_string());
             (serde_json::to_string_pretty(&metrics), output, line)
         }
-        (None, keypoints) => {
-            let keypoints = keypoints.as_ref().ok_or_else(|| UsageError("give --truth or --keypoints".into()))?;
-            let camera = Camera::read(&args.run.join("camera.json"))?;
-            let mut reference = Keypoints::read(keypoints)?;
-            reference.fit_to(camera.width(), camera.height())?;
-            let agreement = agreement(&estimate, &camera, &reference, PCK_THRESHOLD)?;
+        (None, Some(keypoints), None) => {
+            let agreement = keypoint_agreement(&args.run, &estimate, keypoints)?;
             let output = args.output.clone().unwrap_or_else(|| args.run.join("agreement.json"));
             let line = format!(
                 "{} frames, {} points: PCK@{PCK_THRESHOLD} {:.3} ({:.3} with left and right swapped where that agrees better) → {}",
@@ -115,12 +104,35 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             );
             (serde_json::to_string_pretty(&agreement), output, line)
         }
+        (None, None, None) => return Err(UsageError("give --truth, --keypoints or --masks".into()).into()),
     };
     let json = json.expect("metrics are plain numbers and maps") + "\n";
     write_atomic(&output, |w| w.write_all(json.as_bytes()))
         .with_context(|| format!("{}: cannot write", output.display()))?;
     note(global, &line);
     Ok(Outcome::Success)
+}
+
+/// PCK@[`PCK_THRESHOLD`] of a run's estimate (its frames.csv) against the
+/// keypoints in `file`, seen through the run's camera.json.
+pub(super) fn keypoint_agreement(run_dir: &Path, estimate: &Track, file: &Path) -> anyhow::Result<Agreement> {
+    let camera = Camera::read(&run_dir.join("camera.json"))?;
+    let mut reference = Keypoints::read(file)?;
+    reference.fit_to(camera.width(), camera.height())?;
+    Ok(agreement(estimate, &camera, &reference, PCK_THRESHOLD)?)
+}
+
+/// The silhouettes of `input` at a working width of `work_width` (against
+/// `background` when given) compared with the masks in `reference`.
+pub(super) fn silhouette_agreement(
+    input: &Path,
+    background: Option<PathBuf>,
+    work_width: usize,
+    reference: &Path,
+) -> anyhow::Result<MaskAgreement> {
+    let source = FrameSource::open(input, Expect::Auto)?;
+    let mut silhouettes = Silhouettes::new(input, source, background, work_width);
+    Ok(mask_agreement(&mut silhouettes, reference)?)
 }
 
 /// One line: the errors, then the recognition scores that exist.

@@ -46,20 +46,6 @@ pub enum MaskAgreementError {
     Silhouettes(#[from] SilhouetteError),
 }
 
-/// The intersection over union of two masks of one size (1 when both are
-/// empty).
-pub fn iou(a: &Mask, b: &Mask) -> f64 {
-    let (both, either) = overlap(a, b);
-    if either == 0 { 1.0 } else { both as f64 / either as f64 }
-}
-
-fn overlap(a: &Mask, b: &Mask) -> (usize, usize) {
-    a.pixels()
-        .iter()
-        .zip(b.pixels())
-        .fold((0, 0), |(both, either), (&p, &q)| (both + usize::from(p & q), either + usize::from(p | q)))
-}
-
 /// Compares every frame's silhouette from `silhouettes` with the mask of the
 /// same index in `reference` (a folder of images, white where the person
 /// is, in name order), both at the silhouettes' working size.
@@ -109,8 +95,8 @@ pub fn mask_agreement(silhouettes: &mut Silhouettes, reference: &Path) -> Result
             continue;
         }
         frames += 1;
-        ious.push(iou(&ours, &theirs));
-        let (b, _) = overlap(&ours, &theirs);
+        ious.push(ours.iou(&theirs));
+        let (b, _) = ours.overlap(&theirs);
         (both, held, shown) = (both + b, held + theirs.count(), shown + ours.count());
     }
     if frames == 0 {
@@ -136,17 +122,4 @@ pub fn mask_agreement(silhouettes: &mut Silhouettes, reference: &Path) -> Result
 fn count_rest(silhouettes: &mut Silhouettes) -> usize {
     let mut mask = Mask::new(1, 1);
     1 + std::iter::from_fn(|| silhouettes.next_into(&mut mask)).count()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn iou_counts_shared_over_either() {
-        let a = Mask::from_fn(4, 1, |x, _| x < 2);
-        let b = Mask::from_fn(4, 1, |x, _| (1..4).contains(&x));
-        assert_eq!(iou(&a, &b), 0.25);
-        assert_eq!(iou(&Mask::new(3, 3), &Mask::new(3, 3)), 1.0);
-    }
 }

@@ -48,7 +48,9 @@ const LOCAL_REDUCTION: usize = 4;
 pub fn learn_background(frames: &[Frame]) -> LearnedBackground {
     let (width, height) = (frames[0].width(), frames[0].height());
     let pixels = width * height;
-    let locals: Vec<Vec<u8>> = frames.iter().map(local_background).collect();
+    let small = (width.div_ceil(LOCAL_REDUCTION), height.div_ceil(LOCAL_REDUCTION));
+    let mut shrinker = Shrinker::new((width, height), small);
+    let locals: Vec<Vec<u8>> = frames.iter().map(|frame| local_background(frame, &mut shrinker)).collect();
     // The first guesses, widened by a margin of about 1% of the width.
     let margin = (width / 100).max(1);
     let guesses: Vec<Vec<bool>> = frames
@@ -64,14 +66,15 @@ pub fn learn_background(frames: &[Frame]) -> LearnedBackground {
         .collect();
     let mut background = vec![0u8; pixels * 3];
     let (mut values, mut never_seen) = (Vec::with_capacity(frames.len()), 0usize);
+    let mut sources: Vec<&[u8]> = Vec::with_capacity(frames.len());
     for p in 0..pixels {
-        let free: Vec<usize> = (0..frames.len()).filter(|&k| !guesses[k][p]).collect();
-        let sources: Vec<&[u8]> = if free.len() >= MIN_FREE {
-            free.iter().map(|&k| frames[k].rgb()).collect()
-        } else {
-            never_seen += usize::from(free.is_empty());
-            locals.iter().map(Vec::as_slice).collect()
-        };
+        sources.clear();
+        sources.extend(frames.iter().zip(&guesses).filter(|(_, guess)| !guess[p]).map(|(f, _)| f.rgb()));
+        if sources.len() < MIN_FREE {
+            never_seen += usize::from(sources.is_empty());
+            sources.clear();
+            sources.extend(locals.iter().map(Vec::as_slice));
+        }
         for c in 0..3 {
             values.clear();
             values.extend(sources.iter().map(|rgb| rgb[3 * p + c]));
@@ -109,12 +112,13 @@ fn median_u32(values: &mut [u32]) -> u32 {
 }
 
 /// The frame's local background at full size: each channel's median over a
-/// window [`LOCAL_WINDOW_SHARE`] of the width, on the frame reduced
-/// [`LOCAL_REDUCTION`]-fold, each reduced pixel covering its block.
-fn local_background(frame: &Frame) -> Vec<u8> {
+/// window [`LOCAL_WINDOW_SHARE`] of the width, on the frame reduced by
+/// `shrinker` ([`LOCAL_REDUCTION`]-fold), each reduced pixel covering its
+/// block.
+fn local_background(frame: &Frame, shrinker: &mut Shrinker) -> Vec<u8> {
     let (width, height) = (frame.width(), frame.height());
-    let (small_width, small_height) = (width.div_ceil(LOCAL_REDUCTION), height.div_ceil(LOCAL_REDUCTION));
-    let small = Shrinker::new((width, height), (small_width, small_height)).shrink(frame.clone());
+    let (small_width, small_height) = shrinker.size();
+    let small = shrinker.shrink(frame.clone());
     let radius = ((LOCAL_WINDOW_SHARE * small_width as f64) / 2.0).round().max(1.0) as usize;
     let median = median_filter(small.rgb(), small_width, small_height, radius);
     let mut local = vec![0u8; width * height * 3];

@@ -75,6 +75,22 @@ impl Mask {
     pub fn count(&self) -> usize {
         self.pixels.iter().map(|&p| p as usize).sum()
     }
+
+    /// How many pixels are set in both masks, and in either (masks of one
+    /// size).
+    pub fn overlap(&self, other: &Mask) -> (usize, usize) {
+        debug_assert_eq!((self.width, self.height), (other.width, other.height), "masks of one size");
+        self.pixels
+            .iter()
+            .zip(&other.pixels)
+            .fold((0, 0), |(both, either), (&p, &q)| (both + usize::from(p & q), either + usize::from(p | q)))
+    }
+
+    /// Intersection over union with `other` (1 when both are empty).
+    pub fn iou(&self, other: &Mask) -> f64 {
+        let (both, either) = self.overlap(other);
+        if either == 0 { 1.0 } else { both as f64 / either as f64 }
+    }
 }
 
 #[cfg(test)]
@@ -90,5 +106,14 @@ mod tests {
         assert_eq!(m.count(), 3);
         m.clear();
         assert_eq!((m.count(), m.width(), m.height()), (0, 4, 3));
+    }
+
+    #[test]
+    fn iou_counts_shared_over_either() {
+        let a = Mask::from_fn(4, 1, |x, _| x < 2);
+        let b = Mask::from_fn(4, 1, |x, _| (1..4).contains(&x));
+        assert_eq!(a.overlap(&b), (1, 4));
+        assert_eq!(a.iou(&b), 0.25);
+        assert_eq!(Mask::new(3, 3).iou(&Mask::new(3, 3)), 1.0);
     }
 }

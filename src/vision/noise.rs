@@ -539,12 +539,6 @@ mod tests {
         mask
     }
 
-    fn iou(a: &Mask, b: &Mask) -> f64 {
-        let both = a.pixels().iter().zip(b.pixels()).filter(|(x, y)| **x == 1 && **y == 1).count();
-        let either = a.pixels().iter().zip(b.pixels()).filter(|(x, y)| **x == 1 || **y == 1).count();
-        both as f64 / either as f64
-    }
-
     #[test]
     fn levels_are_named_or_numbered_and_anything_else_is_refused() {
         for (i, level) in Level::ALL.into_iter().enumerate() {
@@ -572,7 +566,7 @@ mod tests {
                     let mut mask = truth.clone();
                     noise.apply(k, &world, &mut mask);
                     assert!(mask.pixels().iter().all(|&p| p <= 1));
-                    iou(&mask, &truth)
+                    mask.iou(&truth)
                 })
                 .collect();
             let mean = scores.iter().sum::<f64>() / scores.len() as f64;

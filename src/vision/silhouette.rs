@@ -758,12 +758,6 @@ mod tests {
         Frame::from_rgb(format!("scene at {cx}"), width, height, rgb)
     }
 
-    fn iou(a: &Mask, b: &Mask) -> f64 {
-        let both = a.pixels().iter().zip(b.pixels()).filter(|&(&p, &q)| p & q == 1).count();
-        let either = a.pixels().iter().zip(b.pixels()).filter(|&(&p, &q)| p | q == 1).count();
-        both as f64 / either as f64
-    }
-
     #[test]
     fn a_silhouette_frame_is_thresholded_at_128() {
         let mut out = vec![9; 6];
@@ -788,13 +782,13 @@ mod tests {
         let mut extractor = Extractor::new(ExtractParams::default()).unwrap();
         extractor.set_background(&Frame::from_rgb("background", width, height, background.clone()));
         let mask = extractor.extract(&frame).unwrap();
-        let score = iou(&mask, &truth);
+        let score = mask.iou(&truth);
         assert!(score > 0.97, "IoU {score}");
 
         // Without shadow suppression the shadow joins the silhouette.
         let mut plain = Extractor::new(ExtractParams::default().shadow_chroma(0)).unwrap();
         plain.set_background(&Frame::from_rgb("background", width, height, background));
-        let score = iou(&plain.extract(&frame).unwrap(), &truth);
+        let score = plain.extract(&frame).unwrap().iou(&truth);
         assert!(score < 0.9, "IoU without shadow suppression {score}");
     }
 
@@ -817,7 +811,7 @@ mod tests {
         extractor.set_background(&learned.frame);
         for (i, frame) in frames.iter().enumerate() {
             let truth = person(width, height, 20.0 + 15.0 * i as f64);
-            let score = iou(&extractor.extract(frame).unwrap(), &truth);
+            let score = extractor.extract(frame).unwrap().iou(&truth);
             assert!(score > 0.95, "frame {i}: IoU {score}");
         }
     }

@@ -7,18 +7,13 @@
 //! each run credits, and its speed.
 
 use super::Work;
+use crate::cli::score::{keypoint_agreement, silhouette_agreement};
 use crate::cli::{arg, invoke};
 use anyhow::Context;
-use imitate::report::agreement::agreement;
 use imitate::report::eval::{Table, TimingRow};
-use imitate::report::mask_agreement::mask_agreement;
-use imitate::report::read_track;
 use imitate::report::run::Run;
-use imitate::vision::camera::Camera;
-use imitate::vision::frames::{Expect, FrameSource};
-use imitate::vision::keypoints::Keypoints;
 use imitate::vision::resize::DEFAULT_WORK_WIDTH;
-use imitate::vision::silhouette::Silhouettes;
+use imitate::vocab::corpus::{Labels, read_labels};
 use serde_json::json;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -26,8 +21,6 @@ use std::path::{Path, PathBuf};
 /// Particles per primitive: the paper's sparse setting, the one the speed
 /// target is set for.
 const PARTICLES: usize = 6;
-/// The share of the reference's torso within which a point agrees.
-const PCK_THRESHOLD: f64 = 0.2;
 /// Labels that name one activity in different corpora (bandai's `punch`,
 /// m21's `box`).
 const SAME_ACTIVITY: &[&[&str]] = &[&["punch", "box"]];
@@ -75,13 +68,11 @@ pub(super) fn mocap_vocabulary(work: &Work, mocap: &Path) -> anyhow::Result<Path
     }
     let mut labels = String::from("file,activity\n");
     for folder in &folders {
-        let file = &folder.labels;
-        let text = std::fs::read_to_string(file).with_context(|| format!("{}: cannot read", file.display()))?;
-        for line in text.lines().skip(1).filter(|l| !l.trim().is_empty()) {
-            let mut fields = line.split(',');
-            if let (Some(take), Some(activity)) = (fields.next(), fields.next()) {
-                labels.push_str(&format!("{},{}\n", take.trim(), activity.trim()));
-            }
+        let Labels::PerFile(takes) = read_labels(&folder.labels)? else {
+            anyhow::bail!("{}: a corpus labels whole takes (`file,activity`)", folder.labels.display());
+        };
+        for (take, activity) in takes {
+            labels.push_str(&format!("{take},{activity}\n"));
         }
     }
     let labels_path = work.path("mocap-labels.csv");
@@ -114,9 +105,7 @@ pub(super) fn section(
         let silhouettes = match &masks {
             Some(masks) => {
                 work.step(&format!("real video: {} silhouettes", clip.name));
-                let source = FrameSource::open(&clip.file, Expect::Auto)?;
-                let mut extracted = Silhouettes::new(&clip.file, source, None, DEFAULT_WORK_WIDTH);
-                Some(mask_agreement(&mut extracted, masks)?.mean_iou)
+                Some(silhouette_agreement(&clip.file, None, DEFAULT_WORK_WIDTH, masks)?.mean_iou)
             }
             None => None,
         };
@@ -145,11 +134,7 @@ pub(super) fn section(
                 evaluations_per_frame: run.summary.likelihood_evaluations_per_frame,
             });
             if let Some(k) = &keypoints {
-                let camera = Camera::read(&out.join("camera.json"))?;
-                let mut reference = Keypoints::read(k)?;
-                reference.fit_to(camera.width(), camera.height())?;
-                let track = read_track(&out.join("frames.csv"))?;
-                pck.insert(observe, agreement(&track, &camera, &reference, PCK_THRESHOLD)?.pck_mirror);
+                pck.insert(observe, keypoint_agreement(&out, &run.track, k)?.pck_mirror);
             }
             if observe == "silhouette" {
                 credited = Some(credit(&run, &clip.activity));
