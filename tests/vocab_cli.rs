@@ -320,8 +320,9 @@ fn impossible_options_are_usage_errors_with_exit_code_2() {
     let tmp = tempfile::tempdir().unwrap();
     let m = mocap();
     let mocap = m.to_str().unwrap();
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 7] = [
         (&["--k", "0"], "--k"),
+        (&["--by-label", "--k", "3"], "by label"),
         (&["--variance", "1.5"], "variance"),
         (&["--min-dims", "6", "--max-dims", "3"], "dims"),
         (&["--method", "guess"], "guess"),
@@ -370,4 +371,34 @@ fn real_captures_segment_and_build_from_the_command_line() {
     let vocabulary = Vocabulary::load(&built).unwrap();
     assert!(vocabulary.primitives().len() >= 8, "{} primitives", vocabulary.primitives().len());
     assert_eq!(vocabulary.build_info().takes.len(), 23);
+}
+
+#[test]
+fn by_label_every_activity_of_the_real_captures_gets_a_primitive_of_its_own() {
+    let Some(real) = real_mocap_dir() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let labels_path = real.join("labels.csv");
+    let built = tmp.path().join("real.vocab");
+    ok(&[&"vocab", &"build", &real, &"--labels", &labels_path, &"--by-label", &"-o", &built]);
+    let labels: BTreeSet<String> = fs::read_to_string(&labels_path)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').nth(1).map(|a| a.trim().to_string()))
+        .collect();
+    let vocabulary = Vocabulary::load(&built).unwrap();
+    let named: BTreeSet<String> =
+        vocabulary.primitives().iter().map(|p| p.majority_label().unwrap().to_string()).collect();
+    assert_eq!(named, labels, "one activity per primitive, every activity named");
+    // Unlabelled, there is nothing to cluster by.
+    let out = imitate()
+        .current_dir(tmp.path())
+        .args(["vocab", "build"])
+        .arg(&real)
+        .args(["--by-label", "-o", "x.vocab"])
+        .output()
+        .unwrap();
+    assert_ne!(out.status.code(), Some(0));
+    assert!(stderr_of(&out).contains("clustering by label needs labelled segments"), "{}", stderr_of(&out));
+    assert!(!tmp.path().join("x.vocab").exists());
 }

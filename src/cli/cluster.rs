@@ -5,6 +5,7 @@ use super::{Global, Outcome, note};
 use anyhow::Context;
 use imitate::vocab::cluster::{Choice, ValidClusterParams, best};
 use imitate::vocab::evaluate::{activities_without_primitive, cluster_scores};
+use imitate::vocab::pipeline::segment_labels;
 use imitate::vocab::stages::{ClusterRecord, Clustered, Embedded};
 use std::path::PathBuf;
 
@@ -26,10 +27,13 @@ pub struct Args {
 /// Clusters embedded segments and says how k was chosen and, where the
 /// segments are labelled, how well clusters match the labels.
 pub fn cluster(mut embedded: Embedded, params: &ValidClusterParams, global: Global) -> anyhow::Result<Clustered> {
-    let clustering = params.cluster(&embedded.embedding)?;
+    let clustering = params.cluster(&embedded.embedding, &segment_labels(&embedded.segments.rows))?;
     let score = clustering.score().unwrap_or(f64::NAN);
     let how = match clustering.choice() {
         Choice::Given => format!("k = {} as given (mean silhouette {score:.3})", clustering.k()),
+        Choice::ByLabel => {
+            format!("k = {}: one cluster per activity label (mean silhouette {score:.3})", clustering.k())
+        }
         Choice::Silhouette => {
             let tried = clustering.scores();
             let (low, high) = (tried.first().map_or(0, |t| t.k), tried.last().map_or(0, |t| t.k));

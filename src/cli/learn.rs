@@ -174,6 +174,10 @@ pub struct ClusterArgs {
     /// Seed of k-means' initial centroids.
     #[arg(long, default_value_t = ClusterParams::default().seed)]
     pub seed: u64,
+    /// One cluster per activity label (the unlabelled segments clustered
+    /// as usual), so every labelled activity has a primitive of its own.
+    #[arg(long)]
+    pub by_label: bool,
 }
 
 impl ClusterArgs {
@@ -185,6 +189,7 @@ impl ClusterArgs {
             min_size: self.min_size,
             tolerance: self.tolerance,
             seed: self.seed,
+            by_label: self.by_label,
         }
         .check()
         .map_err(|e| UsageError(e.to_string()))

@@ -197,6 +197,7 @@ fn describe(vocabulary: &Vocabulary, path: &Path, bytes: u64, checksum: &str) ->
         let how = match c.choice {
             Choice::Given => format!("as given (mean silhouette {chosen:.3})"),
             Choice::Silhouette => format!("chosen by mean silhouette ({chosen:.3})"),
+            Choice::ByLabel => format!("one per activity label (mean silhouette {chosen:.3})"),
         };
         out.push(format!("  cluster: k = {} {how}, seed {}", c.k, c.params.seed));
     }

@@ -311,6 +311,11 @@ impl BuildParams {
     }
 }
 
+/// Each segment's activity, in order, as clustering by label reads them.
+pub fn segment_labels(rows: &[SegmentRow]) -> Vec<Option<String>> {
+    rows.iter().map(|r| r.label.clone()).collect()
+}
+
 /// Runs all stages; `stage` is told as each one starts (for progress).
 pub fn build(corpus: &Corpus, params: &BuildParams, mut stage: impl FnMut(&str)) -> Result<Build, BuildError> {
     stage("segment");
@@ -318,7 +323,7 @@ pub fn build(corpus: &Corpus, params: &BuildParams, mut stage: impl FnMut(&str))
     stage("embed");
     let embedding = embed_segments(corpus, &segments, &params.embed)?;
     stage("cluster");
-    let clustering = params.cluster.cluster(&embedding)?;
+    let clustering = params.cluster.cluster(&embedding, &segment_labels(&segments))?;
     stage("fit");
     let fitted = fit_primitives(corpus, &segments, &clustering, &params.fit)?;
     Ok(Build { segments, embedding, clustering, fitted })

@@ -59,7 +59,10 @@ fn clips(dir: &Path) -> anyhow::Result<Vec<Clip>> {
 }
 
 /// A vocabulary learned from every corpus under `mocap` (each subfolder with
-/// a labels.csv), their labels joined into one file.
+/// a labels.csv), their labels joined into one file, one cluster per
+/// activity: recognition is credited by label, and unsupervised clusters
+/// leave some of the clips' activities (raise-up-both-hands, run) without a
+/// primitive.
 pub(super) fn mocap_vocabulary(work: &Work, mocap: &Path) -> anyhow::Result<PathBuf> {
     work.step("real video: a vocabulary of the real motion capture");
     let folders = imitate::report::corpora::corpus_folders(mocap)?;
@@ -80,7 +83,7 @@ pub(super) fn mocap_vocabulary(work: &Work, mocap: &Path) -> anyhow::Result<Path
     let vocab = work.path("mocap.vocab");
     let mut build: Vec<String> = vec!["vocab".into(), "build".into()];
     build.extend(folders.iter().flat_map(|f| f.files.iter().map(|p| arg(p))));
-    build.extend(["--labels".into(), arg(&labels_path), "-o".into(), arg(&vocab)]);
+    build.extend(["--labels".into(), arg(&labels_path), "--by-label".into(), "-o".into(), arg(&vocab)]);
     invoke(&build)?;
     Ok(vocab)
 }
@@ -170,7 +173,7 @@ pub(super) fn section(
         key: "real_video".into(),
         title: "Real video".into(),
         about: format!(
-            "The clips of {dir} tracked with no option but the vocabulary (learned from the real motion capture), \
+            "The clips of {dir} tracked with no option but the vocabulary (learned from the real motion capture, one primitive per activity), \
              {PARTICLES} particles per primitive, eq. 10. Silhouettes: mean IoU with MediaPipe Pose's person masks \
              at the working size. PCK@0.2: the share of shoulders, elbows, wrists and hips within 0.2 torso lengths \
              of MediaPipe's landmarks (left and right swapped where that agrees better), observing the silhouette, \

@@ -18,6 +18,8 @@ pub enum Choice {
     Given,
     /// Chosen by mean silhouette (see [`best`] and `ClusterParams::tolerance`).
     Silhouette,
+    /// One cluster per activity label (`ClusterParams::by_label`).
+    ByLabel,
 }
 
 /// Segments grouped into primitives.
@@ -82,22 +84,69 @@ pub enum ClusterError {
     TooFewSegments(usize),
     #[error("k-means failed: {0}")]
     KMeans(String),
+    #[error("clustering by label needs labelled segments, and none of the {0} is")]
+    NoLabels(usize),
 }
 
 impl ValidClusterParams {
-    /// Clusters the embedded segments.
-    pub fn cluster(&self, embedding: &Embedding) -> Result<Clustering, ClusterError> {
-        let p = self.params();
+    /// Clusters the embedded segments; `labels` are their activities (in
+    /// segment order), which only clustering by label reads.
+    pub fn cluster(&self, embedding: &Embedding, labels: &[Option<String>]) -> Result<Clustering, ClusterError> {
         let n = embedding.len();
         let records = Array2::from_shape_vec((n, embedding.dims()), embedding.coords().to_vec())
             .map_err(|e| ClusterError::KMeans(e.to_string()))?;
+        if self.params().by_label {
+            return self.by_label(&records, labels);
+        }
+        self.cluster_records(&records)
+    }
+
+    /// One cluster per label; the unlabelled segments clustered among
+    /// themselves as [`Self::cluster_records`] does (one cluster when they
+    /// are too few to choose k).
+    fn by_label(&self, records: &Array2<f64>, labels: &[Option<String>]) -> Result<Clustering, ClusterError> {
+        let n = records.nrows();
+        assert_eq!(labels.len(), n, "one label per segment");
+        let mut ids: std::collections::BTreeMap<&str, usize> = std::collections::BTreeMap::new();
+        let mut assignments: Vec<Option<usize>> = labels
+            .iter()
+            .map(|l| {
+                l.as_deref().map(|l| {
+                    let next = ids.len();
+                    *ids.entry(l).or_insert(next)
+                })
+            })
+            .collect();
+        if ids.is_empty() {
+            return Err(ClusterError::NoLabels(n));
+        }
+        let unlabelled: Vec<usize> = (0..n).filter(|&i| assignments[i].is_none()).collect();
+        if !unlabelled.is_empty() {
+            let first = ids.len();
+            let own = if unlabelled.len() < 3 {
+                vec![0; unlabelled.len()]
+            } else {
+                self.cluster_records(&records.select(ndarray::Axis(0), &unlabelled))?.assignments
+            };
+            unlabelled.iter().zip(own).for_each(|(&i, c)| assignments[i] = Some(first + c));
+        }
+        let assignments =
+            by_first_appearance(&assignments.into_iter().map(|a| a.expect("all assigned")).collect::<Vec<_>>());
+        let k = assignments.iter().max().map_or(0, |m| m + 1);
+        let tried = score(records, &assignments, k);
+        Ok(Clustering { assignments, k, choice: Choice::ByLabel, scores: vec![tried] })
+    }
+
+    fn cluster_records(&self, records: &Array2<f64>) -> Result<Clustering, ClusterError> {
+        let p = self.params();
+        let n = records.nrows();
         let (assignments, choice, scores) = match p.k {
             Some(k) => {
                 if k > n {
                     return Err(ClusterError::TooManyClusters { k, segments: n });
                 }
-                let a = self.kmeans(&records, k)?;
-                let tried = score(&records, &a, k);
+                let a = self.kmeans(records, k)?;
+                let tried = score(records, &a, k);
                 (a, Choice::Given, vec![tried])
             }
             None => {
@@ -107,8 +156,8 @@ impl ValidClusterParams {
                 let tried = (2..=p.max_k.min(n - 1))
                     .into_par_iter()
                     .map(|k| {
-                        let a = self.kmeans(&records, k)?;
-                        Ok((score(&records, &a, k), a))
+                        let a = self.kmeans(records, k)?;
+                        Ok((score(records, &a, k), a))
                     })
                     .collect::<Result<Vec<_>, ClusterError>>()?;
                 let scores: Vec<Tried> = tried.iter().map(|t| t.0).collect();
@@ -248,7 +297,7 @@ mod tests {
 
     #[test]
     fn the_number_of_primitives_is_chosen_by_silhouette() {
-        let c = ClusterParams::new().check().unwrap().cluster(&blobs()).unwrap();
+        let c = ClusterParams::new().check().unwrap().cluster(&blobs(), &[]).unwrap();
         assert_eq!(c.k(), 3);
         assert_eq!(c.choice(), &Choice::Silhouette);
         let best = c.score().unwrap();
@@ -260,15 +309,38 @@ mod tests {
     #[test]
     fn a_given_k_is_used_and_too_large_a_k_is_an_error() {
         let params = ClusterParams::new().k(Some(2)).check().unwrap();
-        let c = params.cluster(&blobs()).unwrap();
+        let c = params.cluster(&blobs(), &[]).unwrap();
         assert_eq!((c.k(), c.choice()), (2, &Choice::Given));
-        let err = ClusterParams::new().k(Some(61)).check().unwrap().cluster(&blobs()).unwrap_err();
+        let err = ClusterParams::new().k(Some(61)).check().unwrap().cluster(&blobs(), &[]).unwrap_err();
         assert_eq!(err.to_string(), "--k 61 asks for more primitives than the 60 segments there are");
+    }
+
+    #[test]
+    fn by_label_each_activity_is_one_cluster_and_the_unlabelled_are_clustered() {
+        // Labels that cut across the blobs: the first 30 segments `a`, the
+        // next 15 `b`; the last 15 unlabelled, clustered by where they lie.
+        let labels: Vec<Option<String>> =
+            (0..60).map(|i| [Some("a"), Some("b"), None][i / 30 + i / 45].map(String::from)).collect();
+        let c = ClusterParams::new().by_label(true).check().unwrap().cluster(&blobs(), &labels).unwrap();
+        assert_eq!(c.choice(), &Choice::ByLabel);
+        let a = c.assignments();
+        assert!(a[..30].iter().all(|&x| x == 0) && a[30..45].iter().all(|&x| x == 1), "{a:?}");
+        // The unlabelled fall in the three blobs, each its own cluster.
+        let blob = |i: usize| (i * 7) % 3;
+        for i in 45..60 {
+            for j in 45..60 {
+                assert_eq!(a[i] == a[j], blob(i) == blob(j), "{i} {j}: {a:?}");
+            }
+        }
+        assert_eq!(c.k(), 5);
+        let none: Vec<Option<String>> = vec![None; 60];
+        let err = ClusterParams::new().by_label(true).check().unwrap().cluster(&blobs(), &none).unwrap_err();
+        assert_eq!(err.to_string(), "clustering by label needs labelled segments, and none of the 60 is");
     }
 
     #[test]
     fn the_same_seed_gives_the_same_clusters() {
         let params = ClusterParams::new().seed(5).check().unwrap();
-        assert_eq!(params.cluster(&blobs()).unwrap(), params.cluster(&blobs()).unwrap());
+        assert_eq!(params.cluster(&blobs(), &[]).unwrap(), params.cluster(&blobs(), &[]).unwrap());
     }
 }
