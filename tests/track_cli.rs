@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::imitate;
+use common::{imitate, real_video_dir};
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Output;
@@ -75,15 +75,20 @@ fn a_video_tracks_to_a_trajectory_frames_table_and_summary_the_same_on_one_or_fo
         assert!((probabilities.iter().sum::<f64>() - 1.0).abs() < 1e-9);
         assert!(fields[3 + names.len()..].iter().all(|v| v.parse::<f64>().unwrap().is_finite()));
     }
-    // likelihoods.csv: each primitive's R, one row per frame, all positive.
+    // likelihoods.csv: each primitive's R, then its evidence, one row per
+    // frame, all positive.
     let likelihoods = fs::read_to_string(a.join("likelihoods.csv")).unwrap();
     let header: Vec<String> = likelihoods.lines().next().unwrap().split(',').map(String::from).collect();
-    let expected: Vec<String> =
-        std::iter::once("frame".to_string()).chain(names.iter().map(|n| format!("likelihood_{n}"))).collect();
+    let expected: Vec<String> = std::iter::once("frame".to_string())
+        .chain(names.iter().map(|n| format!("likelihood_{n}")))
+        .chain(names.iter().map(|n| format!("evidence_{n}")))
+        .collect();
     assert_eq!(header, expected);
     assert_eq!(likelihoods.lines().count(), truth.lines().count());
     for line in likelihoods.lines().skip(1) {
-        assert!(line.split(',').skip(1).all(|v| v.parse::<f64>().unwrap() > 0.0), "{line}");
+        let values: Vec<f64> = line.split(',').skip(1).map(|v| v.parse().unwrap()).collect();
+        assert_eq!(values.len(), 2 * names.len());
+        assert!(values.iter().all(|&v| v > 0.0), "{line}");
     }
     let frames = truth.lines().count() - 1;
     assert_eq!(summary["frames"], frames);
@@ -501,4 +506,36 @@ fn frames_cut_to_another_scene_are_coasted_and_counted_not_tracked_as_a_person()
     let activity = |k: usize| frames.lines().nth(k + 1).unwrap().split(',').nth(2).unwrap().to_string();
     assert!((20..25).all(|k| activity(k).is_empty()), "the cut frames are coasted");
     assert!(!activity(19).is_empty() && !activity(30).is_empty(), "the frames around the cut are tracked");
+}
+
+#[test]
+fn a_real_clip_cut_short_is_tracked_to_where_it_ends_and_the_run_says_so() {
+    let Some(clips) = real_video_dir() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let vocab = shipped("vocab/default.vocab");
+    let bytes = fs::read(clips.join("kth_boxing.avi")).unwrap();
+    fs::write(dir.join("cut.avi"), &bytes[..bytes.len() / 2]).unwrap();
+    let out = imitate()
+        .current_dir(dir)
+        .env("RAYON_NUM_THREADS", "2")
+        .args(["track", "cut.avi", "--vocab", vocab.to_str().unwrap(), "-o", "run"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&ok(out).stderr).to_string();
+    let summary = summary_without_timing(&dir.join("run"));
+    let decoding = &summary["decoding"];
+    let read = decoding["frames_read"].as_u64().unwrap();
+    assert_eq!(summary["frames"], read);
+    assert_eq!((decoding["ended_early"].as_bool(), decoding["frames_stated"].as_u64()), (Some(true), Some(448)));
+    assert!((150..300).contains(&read), "half the file holds about half the frames: {read}");
+    let warned = format!("cut.avi: warning: the file ended early: {read} of the 448 frames it states were read");
+    assert!(stderr.contains(&warned), "{stderr}");
+    let rows = fs::read_to_string(dir.join("run/frames.csv")).unwrap().lines().count() - 1;
+    assert_eq!(rows as u64, read);
+    // The whole clip is decoded without complaint.
+    fs::write(dir.join("whole.avi"), &bytes).unwrap();
+    ok(run(dir, &["track", "whole.avi", "--vocab", vocab.to_str().unwrap(), "-o", "whole"], "2"));
+    let summary = summary_without_timing(&dir.join("whole"));
+    assert_eq!((summary["frames"].as_u64(), &summary["decoding"]), (Some(448), &serde_json::Value::Null));
 }

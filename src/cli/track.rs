@@ -16,7 +16,7 @@ use imitate::track::filter::FilterParams;
 use imitate::track::root::Root;
 use imitate::track::tracker::{FrameEstimate, Recognition, TrackParams, Tracker};
 use imitate::vision::camera::Camera;
-use imitate::vision::frames::{Expect, FrameSource, beside_frames, video_frame_rate};
+use imitate::vision::frames::{Expect, FrameSource, VideoProbe, beside_frames, probe_video};
 use imitate::vision::keypoints::{Keypoints, SitePoints};
 use imitate::vision::mask::Mask;
 use imitate::vision::resize::{DEFAULT_WORK_WIDTH, shrink_mask, work_size};
@@ -324,17 +324,21 @@ fn header(names: &[&str]) -> String {
 
 /// The header of `likelihoods.csv`.
 fn likelihood_header(names: &[&str]) -> String {
-    let columns = std::iter::once("frame".to_string()).chain(names.iter().map(|n| format!("likelihood_{n}")));
+    let columns = std::iter::once("frame".to_string())
+        .chain(names.iter().map(|n| format!("likelihood_{n}")))
+        .chain(names.iter().map(|n| format!("evidence_{n}")));
     columns.map(|c| truth::quoted(&c)).collect::<Vec<_>>().join(",") + "\n"
 }
 
 /// One frame's row of `likelihoods.csv`: each primitive's estimate's R
-/// (eq. 8), empty on a frame without a silhouette.
+/// (eq. 8), then each one's evidence, empty on a frame observed by neither
+/// silhouette nor keypoints.
 fn likelihood_row(frame: usize, estimate: &FrameEstimate) -> String {
     let mut line = frame.to_string();
-    for e in &estimate.estimates {
+    let (estimates, evidence) = (estimate.estimates.iter(), estimate.estimates.iter().map(|e| e.evidence));
+    for r in estimates.map(|e| e.likelihood).chain(evidence) {
         line.push(',');
-        if let Some(r) = e.likelihood {
+        if let Some(r) = r {
             write!(line, "{r}").expect("writing to a string cannot fail");
         }
     }
@@ -380,6 +384,50 @@ fn row(
     line
 }
 
+/// What went wrong decoding a video that was still tracked: it ended more
+/// than a frame short of the count its container states (one frame of slack:
+/// containers round, and `running.avi` states 227 for its 226), its decoder
+/// failed after the first frame, or the decoder reported damage it skipped.
+#[derive(Debug, serde::Serialize)]
+struct Decoding {
+    frames_read: usize,
+    frames_stated: Option<usize>,
+    ended_early: bool,
+    /// The decoder's own words: its error, or what it said of the damage.
+    messages: Option<String>,
+}
+
+impl Decoding {
+    /// `None` when the video was decoded whole without complaint.
+    fn of(probe: &VideoProbe, frames_read: usize, silhouettes: &Silhouettes) -> Option<Decoding> {
+        let failed = silhouettes.decoding_failed();
+        let ended_early = failed.is_some() || probe.frames.is_some_and(|stated| frames_read + 1 < stated);
+        let messages = failed.or(silhouettes.source().decoder_messages()).map(str::to_string);
+        (ended_early || messages.is_some()).then_some(Decoding {
+            frames_read,
+            frames_stated: probe.frames,
+            ended_early,
+            messages,
+        })
+    }
+}
+
+impl std::fmt::Display for Decoding {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match (self.ended_early, self.frames_stated) {
+            (true, Some(stated)) => {
+                write!(f, "the file ended early: {} of the {stated} frames it states were read", self.frames_read)?
+            }
+            (true, None) => write!(f, "the file ended early: {} frames were read", self.frames_read)?,
+            (false, _) => write!(f, "the decoder reported damage it skipped")?,
+        }
+        match self.messages.as_deref().and_then(|m| m.lines().next()) {
+            Some(first) => write!(f, " ({first})"),
+            None => Ok(()),
+        }
+    }
+}
+
 /// Where the frame rate came from.
 #[derive(Clone, Copy, Debug, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -393,12 +441,12 @@ enum RateFrom {
 /// The frames' rate: `--fps`, else a video's own, else (a folder) the
 /// rate of the truth.csv `render` wrote beside it, else 15 (the paper's
 /// camera).
-fn frame_rate(args: &Args, source: &FrameSource) -> anyhow::Result<(f64, RateFrom)> {
+fn frame_rate(args: &Args, probe: Option<&VideoProbe>) -> anyhow::Result<(f64, RateFrom)> {
     if let Some(fps) = args.fps {
         return Ok((fps, RateFrom::Option));
     }
-    if source.is_video() {
-        return match video_frame_rate(&args.input)? {
+    if let Some(probe) = probe {
+        return match probe.rate {
             Some(fps) if fps <= 1000.0 => Ok((fps, RateFrom::Video)),
             Some(fps) => Err(UsageError(format!(
                 "{}: the video states {fps} frames a second, more than 1000; pass --fps",
@@ -428,7 +476,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     refuse_nonempty(&args.output, args.force)?;
     let vocabulary = Vocabulary::load(&args.vocab)?;
     let source = FrameSource::open(&args.input, Expect::Auto)?;
-    let (fps, rate_from) = frame_rate(&args, &source)?;
+    let probe = if source.is_video() { Some(probe_video(&args.input)?) } else { None };
+    let (fps, rate_from) = frame_rate(&args, probe.as_ref())?;
     let mut params = params(&args, fps)?;
     let mut given = given_camera(&args, &source)?;
     let frame_size = (source.width(), source.height());
@@ -533,8 +582,17 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     if k == 0 {
         bail!("{}: no frames", args.input.display());
     }
-    if let Some(keypoints) = &keypoints {
-        keypoints.check_frames(k)?;
+    let decoding = probe.and_then(|probe| Decoding::of(&probe, k, &silhouettes));
+    if let Some(decoding) = &decoding {
+        note(global, &format!("{}: warning: {decoding}; the {k} frames read were tracked", args.input.display()));
+    }
+    // Keypoints of the whole video may run past where a damaged copy ends.
+    let keypoints_frames = match &decoding {
+        Some(d) if d.ended_early => d.frames_stated,
+        _ => Some(k),
+    };
+    if let (Some(keypoints), Some(frames)) = (&keypoints, keypoints_frames) {
+        keypoints.check_frames(frames)?;
     }
     let seconds = started.elapsed().as_secs_f64();
     let evaluations = follower.evaluations() + camera_estimate.as_ref().map_or(0, |e| e.evaluations);
@@ -563,6 +621,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         "fps": fps,
         "fps_from": rate_from,
         "frames": k,
+        "decoding": decoding,
         "coasted_frames": coasted,
         "unusable_silhouettes": silhouettes.unusable(),
         "likelihood_evaluations": evaluations,

@@ -258,13 +258,25 @@ const FFMPEG: &str = "ffmpeg";
 /// The program that reads a video's frame rate (it comes with ffmpeg).
 const FFPROBE: &str = "ffprobe";
 
-/// A video's frame rate as its container states it, frames per second:
-/// the average rate, else the nominal one; `None` when it states neither
-/// (a rate of 0/0).
-pub fn video_frame_rate(path: &Path) -> Result<Option<f64>, FrameError> {
+/// What a video's container states of its video stream, read by ffprobe
+/// before decoding.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VideoProbe {
+    /// Frames per second: the average rate, else the nominal one; `None`
+    /// when it states neither (a rate of 0/0).
+    pub rate: Option<f64>,
+    /// The number of frames, where the container states it (AVI and MP4
+    /// do, and keep stating it when the file is cut short; Matroska does
+    /// not).
+    pub frames: Option<usize>,
+}
+
+/// Reads a video's [`VideoProbe`].
+pub fn probe_video(path: &Path) -> Result<VideoProbe, FrameError> {
     let label = path.display().to_string();
     let output = Command::new(FFPROBE)
-        .args(["-v", "error", "-select_streams", "v:0", "-show_entries", "stream=avg_frame_rate,r_frame_rate"])
+        .args(["-v", "error", "-select_streams", "v:0", "-show_entries"])
+        .arg("stream=avg_frame_rate,r_frame_rate,nb_frames")
         .args(["-of", "default=noprint_wrappers=1"])
         .arg(path)
         .stdin(Stdio::null())
@@ -277,19 +289,42 @@ pub fn video_frame_rate(path: &Path) -> Result<Option<f64>, FrameError> {
         let message = String::from_utf8_lossy(&output.stderr).trim().to_string();
         return Err(FrameError::VideoFailed { path: label, frames: 0, message });
     }
-    Ok(parse_frame_rate(&String::from_utf8_lossy(&output.stdout)))
+    Ok(parse_probe(&String::from_utf8_lossy(&output.stdout)))
 }
 
-/// The rate from ffprobe's `key=num/den` lines: `avg_frame_rate` when it is
-/// a positive finite number, else `r_frame_rate`.
-fn parse_frame_rate(text: &str) -> Option<f64> {
+/// A [`VideoProbe`] from ffprobe's `key=value` lines: the rate from
+/// `avg_frame_rate` when it is a positive finite `num/den`, else
+/// `r_frame_rate`; the frames from `nb_frames` when it is a positive count
+/// (ffprobe writes `N/A` when the container does not say).
+fn parse_probe(text: &str) -> VideoProbe {
+    let value = |key: &str| text.lines().find_map(|l| l.trim().strip_prefix(key)?.strip_prefix('='));
     let rate = |key: &str| {
-        let value = text.lines().find_map(|l| l.trim().strip_prefix(key)?.strip_prefix('='))?;
+        let value = value(key)?;
         let (num, den) = value.split_once('/').unwrap_or((value, "1"));
         let rate = num.trim().parse::<f64>().ok()? / den.trim().parse::<f64>().ok()?;
         (rate.is_finite() && rate > 0.0).then_some(rate)
     };
-    rate("avg_frame_rate").or_else(|| rate("r_frame_rate"))
+    let frames = value("nb_frames").and_then(|v| v.trim().parse::<usize>().ok()).filter(|&n| n > 0);
+    VideoProbe { rate: rate("avg_frame_rate").or_else(|| rate("r_frame_rate")), frames }
+}
+
+/// ffmpeg's messages without the memory addresses it tags them with
+/// (`[h264 @ 0x55d0c2a1b2c0] …` becomes `[h264] …`), so what a run keeps of
+/// them is the same from run to run.
+fn without_addresses(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find(" @ 0x") {
+        out.push_str(&rest[..at]);
+        let after = &rest[at + " @ 0x".len()..];
+        let digits = after.find(|c: char| !c.is_ascii_hexdigit()).unwrap_or(after.len());
+        if digits == 0 {
+            out.push_str(" @ 0x");
+        }
+        rest = &after[digits..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// A sequence of frames: the images of a folder, or a video's frames.
@@ -442,7 +477,8 @@ impl FrameSource {
     /// its start by a second ffmpeg (the source's own place is kept), keeping
     /// every `s`-th frame and doubling `s` whenever more than `max` are kept,
     /// so a long video gives between `max / 2` and `max` evenly spaced
-    /// frames and never holds more than `max + 1` at once.
+    /// frames and never holds more than `max + 1` at once; one that fails
+    /// partway gives those of the frames it decoded.
     pub fn sample(&self, max: usize) -> Result<Vec<Frame>, FrameError> {
         let mut frames = Vec::new();
         if max == 0 {
@@ -460,7 +496,13 @@ impl FrameSource {
                 let mut again = Video::spawn(&video.program, Path::new(&video.file))?;
                 let (mut stride, mut index) = (1, 0);
                 while let Some(frame) = again.next_frame(&self.path) {
-                    let frame = self.sized(frame?)?;
+                    let frame = match frame {
+                        Ok(frame) => self.sized(frame)?,
+                        // A video that fails partway is sampled from what it gave; reading it in
+                        // order meets the failure again and reports it.
+                        Err(_) if index > 0 => break,
+                        Err(error) => return Err(error),
+                    };
                     if index % stride == 0 {
                         frames.push(frame);
                         if frames.len() > max {
@@ -602,7 +644,7 @@ impl Video {
                 let mut text = Vec::new();
                 // A read error only shortens the message; the exit status still tells failure.
                 let _ = pipe.read_to_end(&mut text);
-                String::from_utf8_lossy(&text).trim().to_string()
+                without_addresses(String::from_utf8_lossy(&text).trim())
             })
         });
         let mut video = Video {
@@ -1011,29 +1053,47 @@ mod tests {
     }
 
     #[test]
-    fn a_frame_rate_is_the_average_else_the_nominal_else_none() {
-        assert_eq!(parse_frame_rate("r_frame_rate=30000/1001\navg_frame_rate=355/12\n"), Some(355.0 / 12.0));
-        assert_eq!(parse_frame_rate("r_frame_rate=25/1\navg_frame_rate=0/0\n"), Some(25.0));
-        assert_eq!(parse_frame_rate("r_frame_rate=0/0\navg_frame_rate=0/0\n"), None);
-        assert_eq!(parse_frame_rate("avg_frame_rate=15\n"), Some(15.0));
-        assert_eq!(parse_frame_rate(""), None);
+    fn a_probe_reads_the_average_else_the_nominal_rate_and_a_stated_frame_count() {
+        let rate = |text: &str| parse_probe(text).rate;
+        assert_eq!(rate("r_frame_rate=30000/1001\navg_frame_rate=355/12\n"), Some(355.0 / 12.0));
+        assert_eq!(rate("r_frame_rate=25/1\navg_frame_rate=0/0\n"), Some(25.0));
+        assert_eq!(rate("r_frame_rate=0/0\navg_frame_rate=0/0\n"), None);
+        assert_eq!(rate("avg_frame_rate=15\n"), Some(15.0));
+        assert_eq!(rate(""), None);
+        let frames = |text: &str| parse_probe(text).frames;
+        assert_eq!(frames("avg_frame_rate=25/1\nnb_frames=243\n"), Some(243));
+        assert_eq!(frames("nb_frames=N/A\n"), None);
+        assert_eq!(frames("nb_frames=0\n"), None);
     }
 
     #[test]
-    fn a_video_states_its_own_frame_rate() {
+    fn ffmpeg_s_memory_addresses_are_left_out_of_its_messages() {
+        let said = "[mpeg4 @ 0x56388d941140] ac-tex damaged at 1 1\n[mpeg4 @ 0x56388d941140] Error at MB: 12";
+        assert_eq!(without_addresses(said), "[mpeg4] ac-tex damaged at 1 1\n[mpeg4] Error at MB: 12");
+        assert_eq!(without_addresses("a @ 0xz and @ 0x"), "a @ 0xz and @ 0x");
+    }
+
+    #[test]
+    fn a_video_states_its_own_frame_rate_and_where_it_can_its_length() {
         if !ffmpeg_on_path() {
             return;
         }
         let dir = TempDir::new().unwrap();
-        let video = dir.path().join("clip.mkv");
-        let made = Command::new(FFMPEG)
-            .args(["-v", "error", "-f", "lavfi", "-i", "testsrc=size=32x24:rate=25", "-frames:v", "5", "-r", "29.97"])
-            .arg(&video)
-            .status()
-            .unwrap();
-        assert!(made.success());
-        let rate = video_frame_rate(&video).unwrap().unwrap();
-        assert!((rate - 29.97).abs() < 0.01, "{rate}");
+        // Matroska states no frame count; AVI does.
+        for (name, states_count) in [("clip.mkv", false), ("clip.avi", true)] {
+            let video = dir.path().join(name);
+            let made = Command::new(FFMPEG)
+                .args(["-v", "error", "-f", "lavfi", "-i", "testsrc=size=32x24:rate=25", "-frames:v", "5"])
+                .args(["-r", "29.97"])
+                .arg(&video)
+                .status()
+                .unwrap();
+            assert!(made.success());
+            let probe = probe_video(&video).unwrap();
+            assert!((probe.rate.unwrap() - 29.97).abs() < 0.01, "{name}: {probe:?}");
+            let decoded = frames(&mut FrameSource::open(&video, Expect::Color).unwrap()).len();
+            assert_eq!(probe.frames, states_count.then_some(decoded), "{name}");
+        }
     }
 
     #[test]
