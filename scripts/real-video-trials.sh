@@ -9,7 +9,7 @@
 # the report's real_video table; the report is WORK_DIR/report.
 # MediaPipe is a reference, not ground truth.
 #
-#   bash scripts/real-video-trials.sh [WORK_DIR]        # about 6 minutes on 2 cores
+#   bash scripts/real-video-trials.sh [WORK_DIR]        # about 8 minutes on 2 cores
 source "$(dirname "$0")/common.sh" "$@"
 clips="${IMITATE_REAL_VIDEO:-$(cd "$repo/.." && pwd)/shared/video/real}"
 mocap="${IMITATE_MOCAP:-$(cd "$repo/.." && pwd)/shared/mocap}"

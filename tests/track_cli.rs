@@ -539,3 +539,27 @@ fn a_real_clip_cut_short_is_tracked_to_where_it_ends_and_the_run_says_so() {
     let summary = summary_without_timing(&dir.join("whole"));
     assert_eq!((summary["frames"].as_u64(), &summary["decoding"]), (Some(448), &serde_json::Value::Null));
 }
+
+#[test]
+fn a_real_runner_who_leaves_and_comes_back_is_coasted_while_gone_and_followed_again() {
+    let Some(clips) = real_video_dir() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let clip = clips.join("kth_running.avi");
+    let vocab = shipped("vocab/default.vocab");
+    ok(run(dir, &["track", clip.to_str().unwrap(), "--vocab", vocab.to_str().unwrap(), "-o", "run"], "2"));
+    // The runner crosses the frame again and again, the empty scene between.
+    let frames = fs::read_to_string(dir.join("run/frames.csv")).unwrap();
+    let named: Vec<bool> = frames.lines().skip(1).map(|l| !l.split(',').nth(2).unwrap().is_empty()).collect();
+    let stretches: Vec<usize> = named.split(|&n| !n).map(<[bool]>::len).filter(|&len| len > 0).collect();
+    assert!(stretches.len() >= 3 && stretches.iter().all(|&len| len >= 10), "named stretches {stretches:?}");
+    let summary = summary_without_timing(&dir.join("run"));
+    assert_eq!(summary["frames"], 335);
+    assert_eq!(summary["coasted_frames"], named.iter().filter(|&&n| !n).count());
+    assert!(summary["coasted_frames"].as_u64().unwrap() > 150, "the scene is empty most of the clip");
+    // A coasted frame has no likelihoods.
+    let likelihoods = fs::read_to_string(dir.join("run/likelihoods.csv")).unwrap();
+    for (line, seen) in likelihoods.lines().skip(1).zip(&named) {
+        assert_eq!(line.split(',').nth(1).unwrap().is_empty(), !seen, "{line}");
+    }
+}

@@ -11,7 +11,7 @@ use imitate::fsutil::write_dir_atomic;
 use imitate::report::eval::{Measure, Picture, Provenance, RunScore, Setting, Trial, eval_report};
 use imitate::report::figures;
 use imitate::report::filmstrip::{filmstrip, pick_frames};
-use imitate::report::metrics::{Track, score};
+use imitate::report::metrics::{SETTLE_S, Track, score};
 use imitate::report::read_track;
 use imitate::report::run::Run;
 use imitate::track::filter::FilterParams;
@@ -229,7 +229,7 @@ impl Work {
         invoke(&[&args[..], options].concat())?;
         let run = Run::read(&out)?;
         let truth = read_track(&video.truth)?;
-        let metrics = score(&run.track, &truth, &run.primitives, 0.5)?;
+        let metrics = score(&run.track, &truth, &run.primitives, SETTLE_S)?;
         let scored = RunScore {
             upper_body_mm: metrics.upper_body_mm,
             hand_mm: metrics.hand_mm,
@@ -407,7 +407,7 @@ fn evaluate(args: &Args, global: Global, dir: &Path) -> anyhow::Result<Outcome> 
     work.bar.finish_and_clear();
 
     let first_run = Run::read(&first)?;
-    let first_metrics = score(&first_run.track, &read_track(&front.truth)?, &first_run.primitives, 0.5)?;
+    let first_metrics = score(&first_run.track, &read_track(&front.truth)?, &first_run.primitives, SETTLE_S)?;
     let provenance = Provenance {
         command: format!(
             "imitate eval{}{}{}{} --seed {}",

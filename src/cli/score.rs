@@ -5,7 +5,7 @@ use anyhow::Context;
 use imitate::fsutil::write_atomic;
 use imitate::report::agreement::{Agreement, PCK_THRESHOLD, agreement};
 use imitate::report::mask_agreement::{MaskAgreement, mask_agreement};
-use imitate::report::metrics::{Metrics, Track, score};
+use imitate::report::metrics::{Metrics, SETTLE_S, Track, score};
 use imitate::report::run::Run;
 use imitate::report::{read_primitives, read_track};
 use imitate::vision::camera::Camera;
@@ -54,7 +54,7 @@ pub struct Args {
     pub output: Option<PathBuf>,
     /// Seconds after each switch of the true activity that the settled
     /// accuracy leaves out, while the tracker catches up.
-    #[arg(long, default_value_t = 0.5, value_name = "S")]
+    #[arg(long, default_value_t = SETTLE_S, value_name = "S")]
     pub settle: f64,
 }
 

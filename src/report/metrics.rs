@@ -237,6 +237,10 @@ pub fn latent_projection_mm(primitives: &[Primitive], motion: &Motion) -> Option
     Some(1000.0 * per_frame.iter().sum::<f64>() / per_frame.len() as f64)
 }
 
+/// Seconds after a switch of activity that settled recognition leaves out
+/// while the tracker catches up: `score`'s default and `eval`'s.
+pub const SETTLE_S: f64 = 0.5;
+
 /// Scores `estimate` (a run's `frames.csv`) against `truth` (the render's
 /// `truth.csv`), row by row; the rows must be the same frames. A frame
 /// counts as a switch of activity, and starts a settling window of

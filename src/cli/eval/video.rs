@@ -11,6 +11,7 @@ use crate::cli::score::{keypoint_agreement, silhouette_agreement};
 use crate::cli::{arg, invoke};
 use anyhow::Context;
 use imitate::report::eval::{Table, TimingRow};
+use imitate::report::metrics::SETTLE_S;
 use imitate::report::run::Run;
 use imitate::vision::resize::DEFAULT_WORK_WIDTH;
 use imitate::vocab::corpus::{Labels, read_labels};
@@ -21,9 +22,16 @@ use std::path::{Path, PathBuf};
 /// Particles per primitive: the paper's sparse setting, the one the speed
 /// target is set for.
 const PARTICLES: usize = 6;
-/// Labels that name one activity in different corpora (bandai's `punch`,
-/// m21's `box`).
-const SAME_ACTIVITY: &[&[&str]] = &[&["punch", "box"]];
+/// Labels that name one activity in different corpora: bandai's `punch`
+/// and m21's `box`; bandai's walks, labelled by where they head (a walk
+/// across a side view is someone's `walk-left` or `walk-right`), and m21's
+/// `female-walk`; bandai's `dash`, its run. The vocabulary keeps them apart
+/// (each is a primitive of its own); credit counts any of a group.
+const SAME_ACTIVITY: &[&[&str]] = &[
+    &["punch", "box"],
+    &["walk", "walk-left", "walk-right", "walk-back", "walk-turn-left", "walk-turn-right", "female-walk"],
+    &["run", "dash"],
+];
 
 /// One clip of the folder's labels.csv.
 struct Clip {
@@ -112,7 +120,7 @@ pub(super) fn section(
             }
             None => None,
         };
-        let (mut pck, mut credited, mut failed) = (BTreeMap::new(), None, BTreeMap::new());
+        let (mut pck, mut credited, mut failed) = (BTreeMap::new(), BTreeMap::new(), BTreeMap::new());
         for &observe in observes {
             work.step(&format!("real video: {} ({observe})", clip.name));
             let out = work.path(&format!("runs/real-{}-{observe}", clip.name));
@@ -139,11 +147,12 @@ pub(super) fn section(
             if let Some(k) = &keypoints {
                 pck.insert(observe, keypoint_agreement(&out, &run.track, k)?.pck_mirror);
             }
-            if observe == "silhouette" {
-                credited = Some(credit(&run, &clip.activity));
-            }
+            credited.insert(observe, credit(&run, &clip.activity));
         }
         let cell = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.2}"));
+        let share = |observe: &str| {
+            credited.get(observe).map_or("n/a".to_string(), |c: &Credit| format!("{:.0}%", 100.0 * c.labelled))
+        };
         rows.push(vec![
             clip.name.clone(),
             clip.activity.clone(),
@@ -152,8 +161,10 @@ pub(super) fn section(
             cell(pck.get("silhouette").copied()),
             cell(pck.get("keypoints").copied()),
             cell(pck.get("both").copied()),
-            credited.as_ref().map_or("n/a".into(), |c| format!("{:.0}%", 100.0 * c.labelled)),
-            match (&credited, failed.get("silhouette")) {
+            share("silhouette"),
+            share("keypoints"),
+            share("both"),
+            match (credited.get("silhouette"), failed.get("silhouette")) {
                 (Some(c), _) => c.top.clone(),
                 (None, Some(why)) => format!("not tracked: {why}"),
                 (None, None) => "n/a".into(),
@@ -163,9 +174,9 @@ pub(super) fn section(
             "clip": clip.name, "activity": clip.activity, "camera": clip.camera,
             "silhouette_iou": silhouettes,
             "pck_silhouette": pck.get("silhouette"), "pck_keypoints": pck.get("keypoints"), "pck_both": pck.get("both"),
-            "labelled_activity_share": credited.as_ref().map(|c| c.labelled),
-            "frames_named": credited.as_ref().map(|c| c.frames),
-            "credited": credited.as_ref().map(|c| &c.shares),
+            "labelled_activity_share": credited.iter().map(|(o, c)| (*o, c.labelled)).collect::<BTreeMap<_, _>>(),
+            "frames_settled": credited.iter().map(|(o, c)| (*o, c.frames)).collect::<BTreeMap<_, _>>(),
+            "credited": credited.iter().map(|(o, c)| (*o, &c.shares)).collect::<BTreeMap<_, _>>(),
             "not_tracked": failed,
         }));
     }
@@ -177,9 +188,11 @@ pub(super) fn section(
              {PARTICLES} particles per primitive, eq. 10. Silhouettes: mean IoU with MediaPipe Pose's person masks \
              at the working size. PCK@0.2: the share of shoulders, elbows, wrists and hips within 0.2 torso lengths \
              of MediaPipe's landmarks (left and right swapped where that agrees better), observing the silhouette, \
-             the keypoints or both. MediaPipe is a reference, not ground truth. Labelled activity: the share of the \
-             silhouette run's frames naming a primitive whose label is the clip's (punch and box count as one); \
-             most named: the labels credited most.",
+             the keypoints or both. MediaPipe is a reference, not ground truth. Labelled: the share of the settled \
+             frames (named, and {SETTLE_S} s or more after the person was last unseen) naming a primitive whose \
+             label is the clip's activity (punch and box count as one, walks whichever way they head as walk, \
+             dash as run), observing the silhouette, the keypoints or both; most named: the labels the silhouette \
+             run credits most.",
             dir = dir.display()
         ),
         columns: [
@@ -190,7 +203,9 @@ pub(super) fn section(
             "PCK silhouette",
             "PCK keypoints",
             "PCK both",
-            "labelled activity",
+            "labelled silhouette",
+            "labelled keypoints",
+            "labelled both",
             "most named",
         ]
         .map(String::from)
@@ -201,8 +216,10 @@ pub(super) fn section(
     Ok((table, timing))
 }
 
-/// What a run credits: the share of its frames naming an activity that
-/// name the clip's, and every label's share.
+/// What a run credits over its settled frames (those naming an activity
+/// [`SETTLE_S`] or more after the person was last unseen, so the filters
+/// have had time to tell the primitives apart): the share naming the
+/// clip's activity, and every label's share.
 struct Credit {
     frames: usize,
     labelled: f64,
@@ -217,12 +234,25 @@ fn credit(run: &Run, activity: &str) -> Credit {
         .iter()
         .map(|(name, label)| (name.as_str(), label.as_deref().unwrap_or(name.as_str())))
         .collect();
+    credit_frames(&label_of, &run.track.activity, &run.track.time_s, activity)
+}
+
+/// [`credit`] of frames naming `named` primitives at `time_s`, each
+/// primitive's label in `label_of`.
+fn credit_frames(label_of: &BTreeMap<&str, &str>, named: &[Option<String>], time_s: &[f64], activity: &str) -> Credit {
     let same = |label: &str| {
         label == activity || SAME_ACTIVITY.iter().any(|group| group.contains(&label) && group.contains(&activity))
     };
     let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-    for named in run.track.activity.iter().flatten() {
-        *counts.entry(label_of.get(named.as_str()).copied().unwrap_or(named).to_string()).or_default() += 1;
+    let mut seen_since = None;
+    for (named, &t) in named.iter().zip(time_s) {
+        let Some(named) = named else {
+            seen_since = None;
+            continue;
+        };
+        if t - *seen_since.get_or_insert(t) >= SETTLE_S {
+            *counts.entry(label_of.get(named.as_str()).copied().unwrap_or(named).to_string()).or_default() += 1;
+        }
     }
     let frames: usize = counts.values().sum();
     let share = |n: usize| if frames == 0 { 0.0 } else { n as f64 / frames as f64 };
@@ -235,5 +265,34 @@ fn credit(run: &Run, activity: &str) -> Credit {
         labelled,
         shares: counts.iter().map(|(l, &n)| (l.clone(), share(n))).collect(),
         top: top.join(", "),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn credit_counts_settled_frames_and_one_activity_s_labels_as_one() {
+        let label_of: BTreeMap<&str, &str> =
+            [("walk-2", "walk"), ("walk-right", "walk-right"), ("dance", "dance")].into_iter().collect();
+        let name = |n: &str| (!n.is_empty()).then(|| n.to_string());
+        // At 10 frames a second: 5 frames settling, 5 settled, the person
+        // unseen for one frame, 5 settling again, 4 settled.
+        let named: Vec<Option<String>> = ["walk-2"; 5]
+            .into_iter()
+            .chain(["walk-right", "walk-right", "dance", "walk-2", "dance"])
+            .chain([""])
+            .chain(["dance"; 5])
+            .chain(["walk-right", "dance", "dance", "dance"])
+            .map(name)
+            .collect();
+        let time_s: Vec<f64> = (0..named.len()).map(|k| k as f64 / 10.0).collect();
+        let walk = credit_frames(&label_of, &named, &time_s, "walk");
+        assert_eq!(walk.frames, 9);
+        assert!((walk.labelled - 4.0 / 9.0).abs() < 1e-12, "{}", walk.labelled);
+        assert_eq!(walk.top, "dance 56%, walk-right 33%");
+        let run = credit_frames(&label_of, &named, &time_s, "run");
+        assert_eq!(run.labelled, 0.0);
     }
 }
