@@ -563,3 +563,22 @@ fn a_real_runner_who_leaves_and_comes_back_is_coasted_while_gone_and_followed_ag
         assert_eq!(line.split(',').nth(1).unwrap().is_empty(), !seen, "{line}");
     }
 }
+
+#[test]
+fn a_real_scene_without_a_person_is_refused_with_nothing_written() {
+    let Some(clips) = real_video_dir() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    // kth_running.avi's frames 35–95, between the runner's first two
+    // crossings: the field with nobody in it.
+    let made = std::process::Command::new("ffmpeg")
+        .args(["-v", "error", "-i"])
+        .arg(clips.join("kth_running.avi"))
+        .args(["-vf", "select='between(n,35,95)'", "-fps_mode", "passthrough", "-c:v", "mpeg4", "-q:v", "2"])
+        .arg(dir.join("empty.avi"))
+        .status()
+        .expect("ffmpeg runs (bash scripts/install-tools.sh ffmpeg)");
+    assert!(made.success());
+    let vocab = shipped("vocab/default.vocab");
+    refused(dir, &["track", "empty.avi", "--vocab", vocab.to_str().unwrap(), "-o", "out"], 2, "pass --camera");
+}
