@@ -533,9 +533,26 @@ fn a_real_clip_cut_short_is_tracked_to_where_it_ends_and_the_run_says_so() {
     assert!(stderr.contains(&warned), "{stderr}");
     let rows = fs::read_to_string(dir.join("run/frames.csv")).unwrap().lines().count() - 1;
     assert_eq!(rows as u64, read);
+    // Keypoints of the whole clip, or of the copy, go with it; those of
+    // a longer video do not.
+    let vocab = vocab.to_str().unwrap();
+    for (name, last, used) in [("whole.csv", 447, true), ("copy.csv", read - 1, true), ("other.csv", 459, false)] {
+        fs::write(
+            dir.join(name),
+            format!("frame,joint,x,y,confidence\n0,left_hip,80,60,0.9\n{last},left_hip,80,60,0.9\n"),
+        )
+        .unwrap();
+        let args = ["track", "cut.avi", "--vocab", vocab, "-o", "out", "--keypoints", name];
+        if used {
+            ok(run(dir, &args, "2"));
+            fs::remove_dir_all(dir.join("out")).unwrap();
+        } else {
+            refused(dir, &args, 1, "other.csv: keypoints of 460 frames, and the video has 448");
+        }
+    }
     // The whole clip is decoded without complaint.
     fs::write(dir.join("whole.avi"), &bytes).unwrap();
-    ok(run(dir, &["track", "whole.avi", "--vocab", vocab.to_str().unwrap(), "-o", "whole"], "2"));
+    ok(run(dir, &["track", "whole.avi", "--vocab", vocab, "-o", "whole"], "2"));
     let summary = summary_without_timing(&dir.join("whole"));
     assert_eq!((summary["frames"].as_u64(), &summary["decoding"]), (Some(448), &serde_json::Value::Null));
 }

@@ -586,13 +586,11 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     if let Some(decoding) = &decoding {
         note(global, &format!("{}: warning: {decoding}; the {k} frames read were tracked", args.input.display()));
     }
-    // Keypoints of the whole video may run past where a damaged copy ends.
-    let keypoints_frames = match &decoding {
-        Some(d) if d.ended_early => d.frames_stated,
-        _ => Some(k),
-    };
-    if let (Some(keypoints), Some(frames)) = (&keypoints, keypoints_frames) {
-        keypoints.check_frames(frames)?;
+    if let Some(keypoints) = &keypoints {
+        // Keypoints of the damaged copy end where it does; those of the
+        // whole video run on to the count it states.
+        let stated = decoding.as_ref().filter(|d| d.ended_early).and_then(|d| d.frames_stated);
+        keypoints.check_frames(k).or_else(|e| stated.map_or(Err(e), |n| keypoints.check_frames(n)))?;
     }
     let seconds = started.elapsed().as_secs_f64();
     let evaluations = follower.evaluations() + camera_estimate.as_ref().map_or(0, |e| e.evaluations);
