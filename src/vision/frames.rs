@@ -255,7 +255,8 @@ pub fn beside_frames(input: &Path, name: &str) -> Option<PathBuf> {
 
 /// The program that decodes videos.
 const FFMPEG: &str = "ffmpeg";
-/// The program that reads a video's frame rate (it comes with ffmpeg).
+/// The program that reads what a video's container states: its frame rate
+/// and frame count (it comes with ffmpeg).
 const FFPROBE: &str = "ffprobe";
 
 /// What a video's container states of its video stream, read by ffprobe
