@@ -11,6 +11,7 @@
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use imitate::track::calibrate::CalibrationParams;
 use imitate::track::filter::FilterParams;
+use imitate::track::open_set::OpenSet;
 use imitate::track::tracker::{Recognition, TrackParams, Tracker};
 use imitate::vision::camera::{Camera, Preset};
 use imitate::vision::mask::Mask;
@@ -44,7 +45,13 @@ fn track(c: &mut Criterion) {
         // frames timed).
         let filter = FilterParams::standard(particles, 5, 1.0 / 15.0);
         let calibration = Some(CalibrationParams::standard(None));
-        let params = TrackParams { filter, recognition: Recognition::FEEDBACK, calibration, seed: 1 };
+        let params = TrackParams {
+            filter,
+            recognition: Recognition::FEEDBACK,
+            calibration,
+            open_set: OpenSet::STANDARD,
+            seed: 1,
+        };
         let mut tracker = Tracker::new(&vocabulary, camera.clone(), params).expect("valid settings");
         let mut k = 0;
         group.bench_function(BenchmarkId::new("4_primitives", particles), |b| {

@@ -54,9 +54,8 @@ fn a_run_becomes_a_self_contained_page_whose_numbers_are_those_of_metrics_json()
     tracked(dir);
     ok(run(dir, &["report", "run", "--truth", "video/truth.csv"]));
     let report = dir.join("run/report");
-    for file in
-        ["index.html", "recognition.png", "recognition.svg", "error.png", "error.svg", "filmstrip.png", "metrics.json"]
-    {
+    let files = ["index.html", "recognition.png", "recognition.svg", "open_set.png", "open_set.svg", "error.png"];
+    for file in files.into_iter().chain(["error.svg", "filmstrip.png", "metrics.json"]) {
         assert!(report.join(file).is_file(), "{file} missing");
     }
     // The scores are `imitate score`'s, byte for byte.
@@ -78,10 +77,10 @@ fn a_run_becomes_a_self_contained_page_whose_numbers_are_those_of_metrics_json()
     }
     // Self-contained: every image inline, nothing fetched.
     let images = html.matches("<img ").count();
-    assert_eq!(images, 3, "Figure 8, the error over time and the filmstrip");
+    assert_eq!(images, 4, "Figure 8, the open set, the error over time and the filmstrip");
     assert_eq!(html.matches("<img src=\"data:image/png;base64,").count(), images);
     assert!(!html.contains("http://") && !html.contains("https://"));
-    for name in ["recognition.png", "error.png", "filmstrip.png"] {
+    for name in ["recognition.png", "open_set.png", "error.png", "filmstrip.png"] {
         let image = image::open(report.join(name)).unwrap();
         assert!(image.width() >= 600 && image.height() >= 200, "{name}: {}×{}", image.width(), image.height());
     }
@@ -110,7 +109,7 @@ fn a_run_becomes_a_self_contained_page_whose_numbers_are_those_of_metrics_json()
     assert_eq!(elbow["joint"], "left_elbow");
     let cells = format!("<td>left_elbow</td><td>{:.2}</td>", elbow["rms_error_deg"].as_f64().unwrap());
     assert!(html.contains(&cells), "{cells}");
-    assert_eq!(html.matches("<img ").count(), 4, "and the humanoid's filmstrip");
+    assert_eq!(html.matches("<img ").count(), 5, "and the humanoid's filmstrip");
     let strip = image::open(dir.join("imitation/humanoid.png")).unwrap();
     assert_eq!(strip.width(), image::open(report.join("filmstrip.png")).unwrap().width());
     // The rest of the report is as without it.
@@ -122,6 +121,7 @@ fn a_run_becomes_a_self_contained_page_whose_numbers_are_those_of_metrics_json()
     let html = fs::read_to_string(dir.join("baseline/report/index.html")).unwrap();
     assert!(html.contains("A baseline run: no primitives, so no recognition."));
     assert!(!dir.join("baseline/report/recognition.png").exists());
+    assert!(!dir.join("baseline/report/open_set.png").exists());
     assert!(dir.join("baseline/report/filmstrip.png").is_file());
 
     browser_check(&report.join("index.html"), "report-screenshot.png");

@@ -13,6 +13,7 @@ use imitate::track::auto_camera::{self, CameraEstimate, FOV_DEG, Focal, Person, 
 use imitate::track::baseline::{AnnealParams, FullSpaceFilter, mean_training_pose};
 use imitate::track::calibrate::{CalibrationParams, CalibrationReport, HEIGHT_M};
 use imitate::track::filter::FilterParams;
+use imitate::track::open_set::OpenSet;
 use imitate::track::root::Root;
 use imitate::track::tracker::{FrameEstimate, Recognition, TrackParams, Tracker};
 use imitate::vision::camera::Camera;
@@ -120,6 +121,14 @@ pub struct Args {
     /// silhouette.
     #[arg(long, value_enum)]
     pub observe: Option<Observe>,
+    /// The open set: a frame is reported unexplained (frames.csv's
+    /// `unexplained`) when the primitive with the most evidence accounts
+    /// for less than this share of what is seen over half a second: of the
+    /// keypoints (weighted by how much they move), those it places within
+    /// PCK@0.2; without keypoints, its silhouette's overlap with the
+    /// person's.
+    #[arg(long, value_name = "FIT", default_value_t = OpenSet::STANDARD.min_fit)]
+    pub unexplained_below: f64,
     /// Replace the output folder if it exists.
     #[arg(long)]
     pub force: bool,
@@ -228,7 +237,9 @@ fn params(args: &Args, fps: f64) -> Result<TrackParams, UsageError> {
     let recognition = if args.feedback { Recognition::FEEDBACK } else { Recognition::Likelihood };
     let filter = FilterParams::standard(args.particles, args.lookahead, 1.0 / fps);
     let calibration = (!args.no_calibrate).then(|| CalibrationParams::standard(args.height));
-    Ok(TrackParams { filter, recognition, calibration, seed: args.seed })
+    let open_set = OpenSet { min_fit: args.unexplained_below, ..OpenSet::STANDARD };
+    open_set.check().map_err(|e| UsageError(format!("--unexplained-below {}: {e}", args.unexplained_below)))?;
+    Ok(TrackParams { filter, recognition, calibration, open_set, seed: args.seed })
 }
 
 /// The camera given (`--camera`, or the camera.json beside the frames) and
@@ -319,6 +330,7 @@ fn header(names: &[&str]) -> String {
     columns.extend(names.iter().map(|n| format!("progress_{n}")));
     columns.extend(["root_x", "root_y", "root_z", "root_heading"].map(String::from));
     columns.extend(truth::position_columns());
+    columns.extend(["unexplained", "fit_silhouette", "fit_keypoints"].map(String::from));
     columns.iter().map(|c| truth::quoted(c)).collect::<Vec<_>>().join(",") + "\n"
 }
 
@@ -379,6 +391,17 @@ fn row(
         .chain(Joint::ALL.iter().flat_map(|&j| world.position(j).to_array()));
     for v in numbers {
         write!(line, ",{v}").expect("writing to a string cannot fail");
+    }
+    line.push(',');
+    if let Some(e) = estimate.filter(|e| e.fit.is_some()) {
+        line.push_str(if e.unexplained { "1" } else { "0" });
+    }
+    let fit = estimate.and_then(|e| e.fit);
+    for part in [fit.and_then(|f| f.silhouette), fit.and_then(|f| f.keypoints)].map(|s| s.map(|s| s.value())) {
+        line.push(',');
+        if let Some(v) = part {
+            write!(line, "{v}").expect("writing to a string cannot fail");
+        }
     }
     line.push('\n');
     line
@@ -540,6 +563,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let bar = progress(global, silhouettes.source().frame_count().unwrap_or(0) as u64, "track");
     let mut mask = Mask::new(camera.width(), camera.height());
     let (mut rows, mut likelihood_rows, mut poses, mut coasted) = (Vec::new(), Vec::new(), Vec::new(), 0usize);
+    let mut unexplained = 0usize;
     let mut k = 0;
     // The frames the camera was estimated from first, then the rest.
     let mut pending = pending.into_iter();
@@ -573,6 +597,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         rows.push(row(k, k as f64 / fps, &names, &pose, estimate.as_ref(), follower.body()));
         if let Some(e) = &estimate {
             likelihood_rows.push(likelihood_row(k, e));
+            unexplained += usize::from(e.unexplained);
         }
         poses.push(pose);
         bar.inc(1);
@@ -621,6 +646,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         "frames": k,
         "decoding": decoding,
         "coasted_frames": coasted,
+        "unexplained_frames": args.baseline.is_none().then_some(unexplained),
         "unusable_silhouettes": silhouettes.unusable(),
         "likelihood_evaluations": evaluations,
         "likelihood_evaluations_per_frame": evaluations as f64 / k as f64,

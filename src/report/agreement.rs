@@ -10,8 +10,8 @@ use crate::vision::keypoints::{Keypoints, Site, torso_px};
 use std::collections::BTreeMap;
 
 /// The share of the reference's torso within which a point agrees, as the
-/// issue's and the literature's PCK@0.2 count it.
-pub const PCK_THRESHOLD: f64 = 0.2;
+/// literature's PCK@0.2 counts it.
+pub const PCK_THRESHOLD: f64 = crate::vision::sighting::PCK_TORSO_SHARE;
 
 /// The points PCK is counted over: shoulders, elbows, wrists and hips,
 /// each with its mirror.

@@ -19,16 +19,49 @@ pub fn activity_spans(run: &Run, truth: &Track) -> Vec<Span> {
         let stands_for = |name: &&str| run.primitives.labels.get(*name).and_then(|l| l.as_deref()) == Some(activity);
         names.iter().position(|n| stands_for(n) || *n == activity)
     };
+    let labels = truth.activity.iter().map(Option::as_deref);
+    spans(&truth.time_s, labels, 1.0 / run.summary.fps, color_of)
+}
+
+/// The stretches of consecutive frames (at `times`) with one label, each
+/// colored by `color_of`; unlabelled frames are not shaded.
+fn spans<'a>(
+    times: &[f64],
+    labels: impl Iterator<Item = Option<&'a str>>,
+    frame_time: f64,
+    color_of: impl Fn(&str) -> Option<usize>,
+) -> Vec<Span> {
     let mut spans: Vec<Span> = Vec::new();
-    let frame_time = 1.0 / run.summary.fps;
-    for (t, activity) in truth.time_s.iter().zip(&truth.activity) {
-        let Some(activity) = activity else { continue };
+    for (t, label) in times.iter().zip(labels) {
+        let Some(label) = label else { continue };
         match spans.last_mut() {
-            Some(last) if last.label == *activity && (t - last.to).abs() < 1.5 * frame_time => last.to = t + frame_time,
-            _ => spans.push(Span { from: *t, to: t + frame_time, label: activity.clone(), color: color_of(activity) }),
+            Some(last) if last.label == label && (t - last.to).abs() < 1.5 * frame_time => last.to = t + frame_time,
+            _ => spans.push(Span { from: *t, to: t + frame_time, label: label.to_string(), color: color_of(label) }),
         }
     }
     spans
+}
+
+/// The open set over time: what share of each frame the primitive with the
+/// most evidence accounted for, by part, against `min_fit`; the frames
+/// judged unexplained shaded. `None` for a run written before the open set
+/// or a baseline run.
+pub fn open_set(run: &Run, min_fit: f64) -> Option<Figure> {
+    let unexplained = run.unexplained.as_ref()?;
+    let time = &run.track.time_s;
+    let end = time.last().copied().unwrap_or(0.0) + 1.0 / run.summary.fps;
+    let mut series: Vec<Series> = lines(time, &run.fits).into_iter().filter(|s| !s.points.is_empty()).collect();
+    series.push(Series {
+        name: "min_fit".into(),
+        color: 3,
+        style: Style::Line,
+        points: vec![line_point(0.0, min_fit), line_point(end, min_fit)],
+    });
+    // Unlabelled shading: the chart's title says what it is.
+    let flags = unexplained.iter().map(|v| v.filter(|v| *v > 0.5).map(|_| ""));
+    let title = "share of the frame the best primitive accounts for (shaded: unexplained)";
+    let shaded = spans(time, flags, 1.0 / run.summary.fps, |_| None);
+    Some(Figure::new(WIDTH, 220, vec![shares_over_time(title, "fit", end, shaded, series)]))
 }
 
 /// Figure 8: a panel per primitive of attractor progress over time, each
@@ -64,32 +97,40 @@ pub fn recognition(run: &Run, truth: Option<&Track>, sharpness: f64) -> Figure {
             series,
         });
     }
-    let series = run
-        .probabilities
-        .iter()
-        .enumerate()
-        .map(|(i, (name, p))| Series {
-            name: name.clone(),
-            color: i,
-            style: Style::Line,
-            points: time
-                .iter()
-                .zip(p)
-                .filter_map(|(&t, p)| Some(Point { size: 0.0, ..Point::new(t, (*p)?) }))
-                .collect(),
-        })
-        .collect();
-    panels.push(Chart {
-        title: "activity probability (mirror-neuron firing)".into(),
+    let series = lines(time, &run.probabilities);
+    panels.push(shares_over_time("activity probability (mirror-neuron firing)", "probability", end, spans, series));
+    Figure::new(WIDTH, 150, panels)
+}
+
+/// A chart of values in [0, 1] over the run's `end` seconds.
+fn shares_over_time(title: &str, y_label: &str, end: f64, spans: Vec<Span>, series: Vec<Series>) -> Chart {
+    Chart {
+        title: title.into(),
         x_label: "time (s)".into(),
-        y_label: "probability".into(),
+        y_label: y_label.into(),
         x_range: (0.0, end),
         y_range: (0.0, 1.05),
         categories: None,
         spans,
         series,
-    });
-    Figure::new(WIDTH, 150, panels)
+    }
+}
+
+/// Each curve over `time` as a line in its own color, through the frames
+/// that have a value.
+fn lines(time: &[f64], curves: &Curves) -> Vec<Series> {
+    let line = |(i, (name, values)): (usize, &(String, Vec<Option<f64>>))| Series {
+        name: name.clone(),
+        color: i,
+        style: Style::Line,
+        points: time.iter().zip(values).filter_map(|(&t, v)| Some(line_point(t, (*v)?))).collect(),
+    };
+    curves.iter().enumerate().map(line).collect()
+}
+
+/// A point of a line, without a dot.
+fn line_point(x: f64, y: f64) -> Point {
+    Point { size: 0.0, ..Point::new(x, y) }
 }
 
 /// Per frame, each primitive's `(R / best R)^sharpness`; `None` where the
@@ -120,7 +161,7 @@ pub fn upper_body_error(estimate: &Track, truth: &Track) -> Vec<f64> {
 /// The upper-body error over time, true activities shaded.
 pub fn error_over_time(run: &Run, truth: &Track) -> Figure {
     let errors = upper_body_error(&run.track, truth);
-    let points = run.track.time_s.iter().zip(&errors).map(|(&t, &e)| Point { size: 0.0, ..Point::new(t, e) }).collect();
+    let points = run.track.time_s.iter().zip(&errors).map(|(&t, &e)| line_point(t, e)).collect();
     let series = vec![Series { name: String::new(), color: 0, style: Style::Line, points }];
     let mut chart = Chart::fitted("upper-body error, root-relative", "time (s)", "mm", series);
     chart.spans = activity_spans(run, truth);

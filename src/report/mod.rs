@@ -92,6 +92,11 @@ impl Table {
         columns.map(|(i, name)| Ok((name.to_string(), self.optional_numbers(i)?))).collect()
     }
 
+    /// The column `name`'s values, or `None` when the table has none.
+    pub fn column(&self, name: &str) -> Result<Option<Vec<Option<f64>>>, ReportError> {
+        self.header.iter().position(|c| c == name).map(|i| self.optional_numbers(i)).transpose()
+    }
+
     fn optional_numbers(&self, col: usize) -> Result<Vec<Option<f64>>, ReportError> {
         self.records
             .iter()

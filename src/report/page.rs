@@ -93,6 +93,29 @@ pub fn run_report(
         );
         files.push(("recognition.png".into(), png));
         files.push(("recognition.svg".into(), svg.into_bytes()));
+        let min_fit = s.settings.pointer("/open_set/min_fit").and_then(|v| v.as_f64());
+        if let (Some((judged, unexplained)), Some(min_fit), Some(figure)) =
+            (run.unexplained_frames(), min_fit, min_fit.and_then(|m| figures::open_set(run, m)))
+        {
+            page.heading("Open set");
+            page.paragraph(&format!(
+                "{unexplained} of the {judged} observed frames ({:.0}%) were unexplained: the primitive with the most \
+                 evidence accounted for less than {min_fit} of what was seen over {} s (of the keypoints, weighted by \
+                 how much they moved, those it placed within PCK@0.2; without keypoints, its silhouette's overlap \
+                 with the person's). There the activity named is only the nearest the vocabulary holds.",
+                100.0 * unexplained as f64 / judged.max(1) as f64,
+                s.settings.pointer("/open_set/window_s").and_then(|v| v.as_f64()).unwrap_or(f64::NAN),
+            ));
+            let (png, svg) = (figure.png(), figure.svg());
+            page.image(
+                &png,
+                "image/png",
+                "open set",
+                "The best primitive's fit over time; shaded: unexplained frames.",
+            );
+            files.push(("open_set.png".into(), png));
+            files.push(("open_set.svg".into(), svg.into_bytes()));
+        }
     } else {
         page.note("A baseline run: no primitives, so no recognition.");
     }

@@ -57,6 +57,11 @@ pub struct Run {
     /// Each primitive's estimate's R (eq. 8), from `likelihoods.csv`;
     /// `None` for a baseline run, which writes none.
     pub likelihoods: Option<Curves>,
+    /// The open set: whether each frame was unexplained (1) or not (0),
+    /// and what share of it the best primitive accounted for (`fit_`
+    /// columns, by part); `None` for runs written before it.
+    pub unexplained: Option<Vec<Option<f64>>>,
+    pub fits: Curves,
     pub summary: RunSummary,
 }
 
@@ -73,6 +78,7 @@ impl Run {
             .map_err(|e| ReportError::Summary { file: summary_path.display().to_string(), message: e.to_string() })?;
         let probabilities = table.prefixed("prob_")?;
         let progress = table.prefixed("progress_")?;
+        let (unexplained, fits) = (table.column("unexplained")?, table.prefixed("fit_")?);
         let likelihoods = match summary.baseline {
             Some(_) => None,
             None => {
@@ -86,7 +92,24 @@ impl Run {
                 Some(table.prefixed("likelihood_")?)
             }
         };
-        Ok(Run { dir: dir.to_path_buf(), track, primitives, probabilities, progress, likelihoods, summary })
+        Ok(Run {
+            dir: dir.to_path_buf(),
+            track,
+            primitives,
+            probabilities,
+            progress,
+            likelihoods,
+            unexplained,
+            fits,
+            summary,
+        })
+    }
+
+    /// Frames the open set judged (observed and tracked by the
+    /// primitives), and of them those unexplained.
+    pub fn unexplained_frames(&self) -> Option<(usize, usize)> {
+        let judged = self.unexplained.as_ref()?.iter().flatten();
+        Some(judged.fold((0, 0), |(all, unexplained), v| (all + 1, unexplained + usize::from(*v > 0.5))))
     }
 
     /// The primitives' names, in `frames.csv` order.

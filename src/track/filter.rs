@@ -1,10 +1,11 @@
 //! One primitive's particle filter in its latent space (eq. 4).
 
 use crate::mocap::body::JointVector;
+use crate::mocap::pose::Pose;
 use crate::track::calibrate::Physique;
 use crate::track::cone::{Cone, ConeScratch};
 use crate::track::root::{Root, RootSearch};
-use crate::vision::scorer::Scorer;
+use crate::vision::scorer::{Fit, Scorer};
 use crate::vision::sighting::Sighting;
 use crate::vocab::primitive::Primitive;
 use glam::DVec3;
@@ -187,6 +188,11 @@ impl<'v> Filter<'v> {
     fn particle_pose(&self, j: usize) -> JointVector {
         let d = self.primitive.dims();
         self.primitive.reconstruct(&self.particles[j * d..(j + 1) * d])
+    }
+
+    /// What share of the frame `pose` accounts for (see [`Scorer::fit`]).
+    pub fn fit(&mut self, sighting: &Sighting, pose: &Pose, tolerance_px: f64, weights: Option<&[f64; 15]>) -> Fit {
+        self.scorer.fit(sighting, pose, tolerance_px, weights)
     }
 
     fn score(&mut self, sighting: &Sighting, x: &JointVector, root: &Root) -> f64 {

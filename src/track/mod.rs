@@ -12,5 +12,6 @@ pub mod baseline;
 pub mod calibrate;
 pub mod cone;
 pub mod filter;
+pub mod open_set;
 pub mod root;
 pub mod tracker;

@@ -6,12 +6,13 @@ use crate::mocap::body::Body;
 use crate::mocap::pose::Pose;
 use crate::track::calibrate::{self, CalibrationParams, CalibrationReport, HeightFrom, Physique, Sample, blend};
 use crate::track::filter::{Estimate, Filter, FilterParams};
+use crate::track::open_set::{Judge, OpenSet, OpenSetError};
 use crate::track::root::Root;
 use crate::vision::camera::Camera;
 use crate::vision::keypoints::{SitePoints, torso_px};
 use crate::vision::mask::Mask;
-use crate::vision::scorer::Scorer;
-use crate::vision::sighting::{KEYPOINT_SIGMA_TORSO_SHARE, KeypointTarget, Sighting};
+use crate::vision::scorer::{Fit, Scorer};
+use crate::vision::sighting::{KEYPOINT_SIGMA_TORSO_SHARE, KeypointTarget, PCK_TORSO_SHARE, Sighting};
 use crate::vocab::vocabulary::Vocabulary;
 use glam::DVec3;
 use rand::SeedableRng;
@@ -60,6 +61,7 @@ pub struct TrackParams {
     /// How the drawn body is fitted to the person; `None` keeps the
     /// canonical body throughout.
     pub calibration: Option<CalibrationParams>,
+    pub open_set: OpenSet,
     pub seed: u64,
 }
 
@@ -72,6 +74,8 @@ pub enum TrackError {
     NoLookahead,
     #[error("the vocabulary has no primitives")]
     EmptyVocabulary,
+    #[error(transparent)]
+    OpenSet(#[from] OpenSetError),
 }
 
 /// One frame's outcome.
@@ -87,6 +91,12 @@ pub struct FrameEstimate {
     pub winner: usize,
     /// The winner's pose.
     pub pose: Pose,
+    /// What share of the frame the primitive with the most evidence
+    /// accounts for; `None` when the filters coasted.
+    pub fit: Option<Fit>,
+    /// No primitive explains the person (see [`OpenSet`]); false when
+    /// the filters coasted.
+    pub unexplained: bool,
 }
 
 pub struct Tracker<'v> {
@@ -101,6 +111,7 @@ pub struct Tracker<'v> {
     winner: usize,
     /// The person's torso in the last keypoints that showed it, pixels.
     torso_px: Option<f64>,
+    open_set: Judge,
 }
 
 impl<'v> Tracker<'v> {
@@ -115,6 +126,7 @@ impl<'v> Tracker<'v> {
         if primitives.is_empty() {
             return Err(TrackError::EmptyVocabulary);
         }
+        params.open_set.check()?;
         // A held height is drawn from the first frame; a fitted one from
         // the first fit.
         let physique = match params.calibration.and_then(|c| c.held_height()) {
@@ -146,6 +158,7 @@ impl<'v> Tracker<'v> {
             placed: false,
             winner: 0,
             torso_px: None,
+            open_set: Judge::new(params.open_set, params.filter.frame_time_s),
         })
     }
 
@@ -200,12 +213,26 @@ impl<'v> Tracker<'v> {
         }
         let chosen = &estimates[self.winner];
         let pose = chosen.root.pose(&chosen.x);
+        let fit = sighting.as_ref().map(|s| self.fit(s, &estimates));
+        let unexplained = fit.is_some_and(|f| self.open_set.unexplained(f));
         if let Some(sighting) = sighting
             && self.placed
         {
             self.calibrate(sighting, pose);
         }
-        FrameEstimate { estimates, probabilities, winner: self.winner, pose }
+        FrameEstimate { estimates, probabilities, winner: self.winner, pose, fit, unexplained }
+    }
+
+    /// What share of the frame the estimate of the primitive with the most
+    /// evidence accounts for; keypoints count within PCK's tolerance of
+    /// the torso seen, weighted by how much they move (see [`OpenSet`]).
+    fn fit(&mut self, sighting: &Sighting, estimates: &[Estimate]) -> Fit {
+        let evidence = |i: usize| estimates[i].evidence.unwrap_or(0.0);
+        let best = (0..estimates.len()).fold(0, |best, i| if evidence(i) > evidence(best) { i } else { best });
+        let pose = estimates[best].root.pose(&estimates[best].x);
+        let tolerance_px = PCK_TORSO_SHARE * self.torso_px.unwrap_or(0.0);
+        let weights = sighting.keypoints().map(|k| self.open_set.site_weights(k.points(), tolerance_px));
+        self.filters[best].fit(sighting, &pose, tolerance_px, weights.as_ref())
     }
 
     /// The keypoints as the filters score them: a detector's error is a
@@ -422,7 +449,8 @@ mod tests {
             frame_time_s: 1.0 / 15.0,
         };
         let camera = Camera::preset(Preset::Front, 40, 30).unwrap();
-        Tracker::new(vocabulary, camera, TrackParams { filter, recognition, calibration: None, seed: 1 }).unwrap()
+        let params = TrackParams { filter, recognition, calibration: None, open_set: OpenSet::STANDARD, seed: 1 };
+        Tracker::new(vocabulary, camera, params).unwrap()
     }
 
     /// Estimates whose likelihoods and evidence are `r` times a common factor.

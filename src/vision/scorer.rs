@@ -73,4 +73,58 @@ impl Scorer {
         };
         r * (-energy).exp()
     }
+
+    /// How much of the frame `pose` accounts for, each part where the
+    /// frame has it: its drawn silhouette's overlap with the observed one
+    /// (pixels in both of those in either), and the keypoints its sites
+    /// fall within `tolerance_px` of (weighted by confidence times
+    /// `site_weights`; see
+    /// [`crate::vision::sighting::KeypointTarget::share_within`]).
+    pub fn fit(
+        &mut self,
+        sighting: &Sighting,
+        pose: &Pose,
+        tolerance_px: f64,
+        site_weights: Option<&[f64; 15]>,
+    ) -> Fit {
+        let world = self.body.forward(pose);
+        let keypoints = sighting.keypoints().map(|k| {
+            let (explained, seen) = k.share_within(&self.camera, &self.body, &world, tolerance_px, site_weights);
+            Share { explained, seen }
+        });
+        let silhouette = sighting.mask().map(|observed| {
+            let (both, either) = self.draw_frame(&world).overlap(observed);
+            Share { explained: both as f64, seen: either as f64 }
+        });
+        Fit { silhouette, keypoints }
+    }
+}
+
+/// How much of what a frame shows a pose accounts for (see
+/// [`Scorer::fit`]), by part.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fit {
+    pub silhouette: Option<Share>,
+    pub keypoints: Option<Share>,
+}
+
+/// An amount explained of an amount seen (pixels, or weighted points).
+/// Shares are pooled by adding both amounts, so a frame that shows little
+/// (a fragment, keypoints without the moving ones) counts for little.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Share {
+    pub explained: f64,
+    pub seen: f64,
+}
+
+impl Share {
+    /// The share explained, in [0, 1]; 1 when nothing was seen.
+    pub fn value(&self) -> f64 {
+        if self.seen > 0.0 { self.explained / self.seen } else { 1.0 }
+    }
+
+    pub fn add(&mut self, other: Share) {
+        self.explained += other.explained;
+        self.seen += other.seen;
+    }
 }

@@ -16,6 +16,10 @@ use glam::DVec3;
 /// pose estimate, is two of these.
 pub const KEYPOINT_SIGMA_TORSO_SHARE: f64 = 0.1;
 
+/// PCK@0.2's tolerance, as a share of the torso: a point this near its
+/// joint counts as placed.
+pub const PCK_TORSO_SHARE: f64 = 2.0 * KEYPOINT_SIGMA_TORSO_SHARE;
+
 /// The largest keypoint energy scored: beyond it every pose explains the
 /// points equally badly, and the score stays a positive number.
 const MAX_ENERGY: f64 = 600.0;
@@ -78,16 +82,48 @@ impl KeypointTarget {
     /// Σ c·d² / 2σ² over the points, d each point's distance (pixels) from
     /// where `camera` sees its site on `world`.
     pub fn energy(&self, camera: &Camera, body: &Body, world: &BodyFrame) -> f64 {
-        let mut energy = 0.0;
-        for (site, point) in Site::ALL.iter().zip(&self.points) {
-            let Some(point) = point else { continue };
+        let energy: f64 = self.squared_misses(camera, body, world).map(|(_, (c, d2))| c * d2).sum();
+        (energy / (2.0 * self.sigma_px * self.sigma_px)).min(MAX_ENERGY)
+    }
+
+    /// How many of the points, weighted by confidence times `weights` (by
+    /// site; all 1 when `None`), lie within `tolerance_px` of where
+    /// `camera` sees their sites on `world`, and of how many in all.
+    pub fn share_within(
+        &self,
+        camera: &Camera,
+        body: &Body,
+        world: &BodyFrame,
+        tolerance_px: f64,
+        weights: Option<&[f64; 15]>,
+    ) -> (f64, f64) {
+        let (mut within, mut all) = (0.0, 0.0);
+        for (i, (c, d2)) in self.squared_misses(camera, body, world) {
+            let w = c * weights.map_or(1.0, |w| w[i]);
+            all += w;
+            if d2 <= tolerance_px * tolerance_px {
+                within += w;
+            }
+        }
+        (within, all)
+    }
+
+    /// Each point's site index, confidence and squared distance (pixels)
+    /// from where `camera` sees its site on `world`.
+    fn squared_misses<'a>(
+        &'a self,
+        camera: &'a Camera,
+        body: &'a Body,
+        world: &'a BodyFrame,
+    ) -> impl Iterator<Item = (usize, (f64, f64))> + 'a {
+        Site::ALL.iter().zip(&self.points).enumerate().filter_map(move |(i, (site, point))| {
+            let point = point.as_ref()?;
             // A site behind the camera is as far off as a point can count.
             let d2 = camera
                 .project(site_position(*site, body, world))
                 .map_or(f64::INFINITY, |(u, v, _)| (u - point.x).powi(2) + (v - point.y).powi(2));
-            energy += point.confidence * d2;
-        }
-        (energy / (2.0 * self.sigma_px * self.sigma_px)).min(MAX_ENERGY)
+            Some((i, (point.confidence, d2)))
+        })
     }
 }
 

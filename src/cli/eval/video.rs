@@ -153,6 +153,14 @@ pub(super) fn section(
         let share = |observe: &str| {
             credited.get(observe).map_or("n/a".to_string(), |c: &Credit| format!("{:.0}%", 100.0 * c.labelled))
         };
+        let unexplained = match observes.iter().any(|o| credited.contains_key(o)) {
+            true => observes
+                .iter()
+                .map(|o| credited.get(o).map_or("n/a".into(), |c| format!("{:.0}%", 100.0 * c.unexplained)))
+                .collect::<Vec<_>>()
+                .join(" / "),
+            false => "n/a".into(),
+        };
         rows.push(vec![
             clip.name.clone(),
             clip.activity.clone(),
@@ -164,6 +172,7 @@ pub(super) fn section(
             share("silhouette"),
             share("keypoints"),
             share("both"),
+            unexplained,
             match (credited.get("silhouette"), failed.get("silhouette")) {
                 (Some(c), _) => c.top.clone(),
                 (None, Some(why)) => format!("not tracked: {why}"),
@@ -175,6 +184,7 @@ pub(super) fn section(
             "silhouette_iou": silhouettes,
             "pck_silhouette": pck.get("silhouette"), "pck_keypoints": pck.get("keypoints"), "pck_both": pck.get("both"),
             "labelled_activity_share": credited.iter().map(|(o, c)| (*o, c.labelled)).collect::<BTreeMap<_, _>>(),
+            "unexplained_share": credited.iter().map(|(o, c)| (*o, c.unexplained)).collect::<BTreeMap<_, _>>(),
             "frames_settled": credited.iter().map(|(o, c)| (*o, c.frames)).collect::<BTreeMap<_, _>>(),
             "credited": credited.iter().map(|(o, c)| (*o, &c.shares)).collect::<BTreeMap<_, _>>(),
             "not_tracked": failed,
@@ -191,8 +201,9 @@ pub(super) fn section(
              the keypoints or both. MediaPipe is a reference, not ground truth. Labelled: the share of the settled \
              frames (named, and {SETTLE_S} s or more after the person was last unseen) naming a primitive whose \
              label is the clip's activity (punch and box count as one, walks whichever way they head as walk, \
-             dash as run), observing the silhouette, the keypoints or both; most named: the labels the silhouette \
-             run credits most.",
+             dash as run), observing the silhouette, the keypoints or both; unexplained: the share of those frames \
+             the open set flagged (no primitive accounts for half of what is seen), observing the silhouette / the \
+             keypoints / both; most named: the labels the silhouette run credits most.",
             dir = dir.display()
         ),
         columns: [
@@ -206,6 +217,7 @@ pub(super) fn section(
             "labelled silhouette",
             "labelled keypoints",
             "labelled both",
+            "unexplained silhouette / keypoints / both",
             "most named",
         ]
         .map(String::from)
@@ -223,6 +235,8 @@ pub(super) fn section(
 struct Credit {
     frames: usize,
     labelled: f64,
+    /// The share of the frames the open set judged unexplained.
+    unexplained: f64,
     shares: BTreeMap<String, f64>,
     top: String,
 }
@@ -234,24 +248,32 @@ fn credit(run: &Run, activity: &str) -> Credit {
         .iter()
         .map(|(name, label)| (name.as_str(), label.as_deref().unwrap_or(name.as_str())))
         .collect();
-    credit_frames(&label_of, &run.track.activity, &run.track.time_s, activity)
+    let unexplained = run.unexplained.as_deref().unwrap_or_default();
+    credit_frames(&label_of, &run.track.activity, unexplained, &run.track.time_s, activity)
 }
 
 /// [`credit`] of frames naming `named` primitives at `time_s`, each
-/// primitive's label in `label_of`.
-fn credit_frames(label_of: &BTreeMap<&str, &str>, named: &[Option<String>], time_s: &[f64], activity: &str) -> Credit {
+/// primitive's label in `label_of`, and those of them `unexplained` (1).
+fn credit_frames(
+    label_of: &BTreeMap<&str, &str>,
+    named: &[Option<String>],
+    unexplained: &[Option<f64>],
+    time_s: &[f64],
+    activity: &str,
+) -> Credit {
     let same = |label: &str| {
         label == activity || SAME_ACTIVITY.iter().any(|group| group.contains(&label) && group.contains(&activity))
     };
     let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-    let mut seen_since = None;
-    for (named, &t) in named.iter().zip(time_s) {
+    let (mut seen_since, mut unexplained_frames) = (None, 0);
+    for (k, (named, &t)) in named.iter().zip(time_s).enumerate() {
         let Some(named) = named else {
             seen_since = None;
             continue;
         };
         if t - *seen_since.get_or_insert(t) >= SETTLE_S {
             *counts.entry(label_of.get(named.as_str()).copied().unwrap_or(named).to_string()).or_default() += 1;
+            unexplained_frames += usize::from(unexplained.get(k).copied().flatten().is_some_and(|v| v > 0.5));
         }
     }
     let frames: usize = counts.values().sum();
@@ -263,6 +285,7 @@ fn credit_frames(label_of: &BTreeMap<&str, &str>, named: &[Option<String>], time
     Credit {
         frames,
         labelled,
+        unexplained: share(unexplained_frames),
         shares: counts.iter().map(|(l, &n)| (l.clone(), share(n))).collect(),
         top: top.join(", "),
     }
@@ -288,11 +311,17 @@ mod tests {
             .map(name)
             .collect();
         let time_s: Vec<f64> = (0..named.len()).map(|k| k as f64 / 10.0).collect();
-        let walk = credit_frames(&label_of, &named, &time_s, "walk");
+        // The first three frames and the last two unexplained: two settled.
+        let unexplained: Vec<Option<f64>> = (0..named.len())
+            .map(|k| named[k].as_ref().map(|_| if k < 3 || k + 2 >= named.len() { 1.0 } else { 0.0 }))
+            .collect();
+        let walk = credit_frames(&label_of, &named, &unexplained, &time_s, "walk");
         assert_eq!(walk.frames, 9);
         assert!((walk.labelled - 4.0 / 9.0).abs() < 1e-12, "{}", walk.labelled);
+        assert!((walk.unexplained - 2.0 / 9.0).abs() < 1e-12, "{}", walk.unexplained);
         assert_eq!(walk.top, "dance 56%, walk-right 33%");
-        let run = credit_frames(&label_of, &named, &time_s, "run");
+        let run = credit_frames(&label_of, &named, &[], &time_s, "run");
+        assert_eq!(run.unexplained, 0.0);
         assert_eq!(run.labelled, 0.0);
     }
 }
