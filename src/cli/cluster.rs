@@ -5,8 +5,9 @@ use super::{Global, Outcome, note};
 use anyhow::Context;
 use imitate::vocab::cluster::{Choice, ValidClusterParams, best};
 use imitate::vocab::evaluate::{activities_without_primitive, cluster_scores};
+use imitate::vocab::lineage::ClusterRecord;
 use imitate::vocab::pipeline::segment_labels;
-use imitate::vocab::stages::{ClusterRecord, Clustered, Embedded};
+use imitate::vocab::stages::{Clustered, Embedded};
 use std::path::PathBuf;
 
 /// Group embedded segments into primitives by k-means (linfa). Without

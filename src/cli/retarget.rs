@@ -7,7 +7,7 @@ use imitate::mocap::bvh::{read_bvh, write_bvh};
 use imitate::mocap::fidelity::{Continuity, DirectionErrors, JUMP_DEG, ThighFacing};
 use imitate::mocap::mapping::UserMapping;
 use imitate::mocap::retarget::{RetargetOptions, Retargeter, UpAxis};
-use imitate::vocab::stages::RetargetSettings;
+use imitate::vocab::lineage::RetargetSettings;
 use std::path::PathBuf;
 
 /// Retarget a BVH file onto the canonical 17-joint humanoid.

@@ -7,9 +7,10 @@ use anyhow::{Context, bail};
 use imitate::mocap::pose::Motion;
 use imitate::mocap::retarget::RetargetOptions;
 use imitate::vocab::corpus::{self, Corpus, read_labels};
+use imitate::vocab::lineage::Lineage;
 use imitate::vocab::pipeline::segment_corpus;
 use imitate::vocab::segment::ValidSegmentParams;
-use imitate::vocab::stages::{Lineage, Segments};
+use imitate::vocab::stages::Segments;
 use std::path::{Path, PathBuf};
 
 /// Cut BVH takes into segments (one row per segment: file, frames,

@@ -6,7 +6,7 @@ use super::{Global, Outcome, count, note, peak_resident_mb, write_stdout};
 use anyhow::Context;
 use imitate::vocab::cluster::Choice;
 use imitate::vocab::container::FORMAT_VERSION;
-use imitate::vocab::stages::Lineage;
+use imitate::vocab::lineage::Lineage;
 use imitate::vocab::vocabulary::Vocabulary;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;

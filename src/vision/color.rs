@@ -11,6 +11,7 @@
 
 use crate::mocap::pose::BodyFrame;
 use crate::vision::camera::Camera;
+use crate::vision::light::light_direction;
 use crate::vision::mask::Mask;
 use crate::vision::noise::Noise;
 use crate::vision::shape::{CAPSULES, Capsule};
@@ -47,16 +48,6 @@ const DIFFUSE: f64 = 0.6;
 const WALL_BEHIND_M: f64 = 2.5;
 /// Floor tiles' side, meters.
 const TILE_M: f64 = 0.5;
-
-/// The direction towards the light: above, behind the camera and to its
-/// left (straight above for a camera looking straight down), so the
-/// shadow falls behind the person and to the image's right.
-pub fn light_direction(camera: &Camera) -> DVec3 {
-    let view = DVec3::from(camera.spec().look_at) - camera.position();
-    let Some(ahead) = DVec3::new(view.x, 0.0, view.z).try_normalize() else { return DVec3::Y };
-    let left = DVec3::Y.cross(ahead);
-    (0.8 * DVec3::Y - 0.5 * ahead + 0.35 * left).normalize()
-}
 
 /// Where a ray first meets a surface: the distance along the (unit) ray and
 /// the outward unit normal there.

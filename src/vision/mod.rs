@@ -8,6 +8,7 @@ pub mod distance;
 pub mod figure;
 pub mod frames;
 pub mod keypoints;
+pub mod light;
 pub mod mask;
 pub mod noise;
 pub mod render;

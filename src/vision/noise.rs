@@ -14,7 +14,7 @@
 use crate::mocap::body::Joint;
 use crate::mocap::pose::BodyFrame;
 use crate::vision::camera::Camera;
-use crate::vision::color::light_direction;
+use crate::vision::light::light_direction;
 use crate::vision::mask::Mask;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};

@@ -16,14 +16,14 @@
 
 use crate::fsutil::write_dir_atomic;
 use crate::mocap::body::{DOF, Joint, Kind};
-use crate::mocap::mapping::{MappingError, UserMapping};
-use crate::mocap::retarget::{RetargetOptions, UpAxis};
-use crate::vocab::cluster::{Choice, ClusterParams, Clustering, Tried};
+use crate::mocap::mapping::MappingError;
+use crate::vocab::cluster::Clustering;
 use crate::vocab::corpus::{self, Corpus, CorpusError};
-use crate::vocab::embed::{EmbedParams, Embedding};
+use crate::vocab::embed::Embedding;
+use crate::vocab::lineage::{Lineage, LineageError};
 use crate::vocab::pipeline::SegmentRow;
 use crate::vocab::primitive::FitParams;
-use crate::vocab::segment::{SegmentParams, Span};
+use crate::vocab::segment::Span;
 use crate::vocab::table::{ColumnType, Table, TableError, Values};
 use crate::vocab::vocabulary::{ARRAYS, BuildInfo, Header, VocabError, Vocabulary};
 use std::path::{Path, PathBuf};
@@ -41,81 +41,6 @@ const BUILD_NOTE: &str = "build";
 /// The note under which a table lists every take segmented.
 const TAKES_NOTE: &str = "takes";
 
-/// How the BVH files were retargeted, as given on the command line.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct RetargetSettings {
-    /// `y` or `z`: the up axis forced with `--up`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub up: Option<String>,
-    /// The joint mapping file given with `--map`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub map: Option<String>,
-}
-
-impl RetargetSettings {
-    pub fn new(up: Option<UpAxis>, map: Option<&Path>) -> RetargetSettings {
-        let up = up.map(|u| match u {
-            UpAxis::Y => "y".to_string(),
-            UpAxis::Z => "z".to_string(),
-        });
-        RetargetSettings { up, map: map.map(|m| m.display().to_string()) }
-    }
-
-    /// The retargeting options, the mapping file read again.
-    pub fn options(&self) -> Result<RetargetOptions, StageError> {
-        let up = match self.up.as_deref() {
-            None => None,
-            Some("y") => Some(UpAxis::Y),
-            Some("z") => Some(UpAxis::Z),
-            Some(other) => return Err(StageError::Provenance(format!("unknown up axis `{other}`"))),
-        };
-        let mapping = self.map.as_deref().map(|m| UserMapping::load(Path::new(m))).transpose()?;
-        Ok(RetargetOptions { up, mapping })
-    }
-}
-
-/// k-means settings and how k was settled.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct ClusterRecord {
-    pub params: ClusterParams,
-    /// The number of clusters (primitives can be more: see
-    /// [`crate::vocab::pipeline::fit_primitives`]).
-    pub k: usize,
-    pub choice: Choice,
-    /// Each k tried: mean silhouette and smallest cluster.
-    pub tried: Vec<Tried>,
-}
-
-impl ClusterRecord {
-    pub fn new(params: ClusterParams, clustering: &Clustering) -> ClusterRecord {
-        ClusterRecord {
-            params,
-            k: clustering.k(),
-            choice: clustering.choice().clone(),
-            tried: clustering.scores().to_vec(),
-        }
-    }
-}
-
-/// How a stage file was made: the settings of every stage so far.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Lineage {
-    /// The imitate version that ran the first stage.
-    pub imitate: String,
-    pub retarget: RetargetSettings,
-    pub segment: SegmentParams,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub embed: Option<EmbedParams>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub cluster: Option<ClusterRecord>,
-}
-
-impl Lineage {
-    pub fn new(retarget: RetargetSettings, segment: SegmentParams) -> Lineage {
-        Lineage { imitate: env!("CARGO_PKG_VERSION").to_string(), retarget, segment, embed: None, cluster: None }
-    }
-}
-
 #[derive(Debug, thiserror::Error)]
 pub enum StageError {
     #[error(transparent)]
@@ -130,8 +55,8 @@ pub enum StageError {
     BadRow { path: String, row: usize, problem: String },
     #[error("{path}: {problem}")]
     Bad { path: String, problem: String },
-    #[error("the recorded retargeting settings are unusable: {0}")]
-    Provenance(String),
+    #[error(transparent)]
+    Lineage(#[from] LineageError),
     #[error("{path}: cannot {action}: {source}")]
     Io { path: String, action: &'static str, source: std::io::Error },
 }
@@ -533,6 +458,9 @@ mod tests {
     use super::*;
     use crate::mocap::body::Body;
     use crate::mocap::pose::{Motion, Pose};
+    use crate::mocap::retarget::UpAxis;
+    use crate::vocab::lineage::RetargetSettings;
+    use crate::vocab::segment::SegmentParams;
 
     fn still_take(frames: usize, frame_time_s: f64) -> Motion {
         let body = Body::standard();

@@ -6,8 +6,8 @@
 use crate::fsutil::write_atomic;
 use crate::mocap::body::{Body, DOF, Joint, JointVector, Kind, Proportions};
 use crate::vocab::container::{Container, ContainerError};
+use crate::vocab::lineage::Lineage;
 use crate::vocab::primitive::{Field, FitParams, Primitive, Source, SpeedStats};
-use crate::vocab::stages::Lineage;
 use std::io::Write;
 use std::path::Path;
 
