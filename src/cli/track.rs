@@ -17,12 +17,13 @@ use imitate::track::open_set::OpenSet;
 use imitate::track::root::Root;
 use imitate::track::tracker::{FrameEstimate, Recognition, TrackParams, Tracker};
 use imitate::vision::camera::Camera;
-use imitate::vision::frames::{Expect, FrameSource, VideoProbe, beside_frames, probe_video};
+use imitate::vision::frames::{Expect, FrameSource, beside_frames};
 use imitate::vision::keypoints::{Keypoints, SitePoints};
 use imitate::vision::mask::Mask;
 use imitate::vision::resize::{DEFAULT_WORK_WIDTH, shrink_mask, work_size};
 use imitate::vision::silhouette::Silhouettes;
 use imitate::vision::truth;
+use imitate::vision::video::{VideoProbe, probe_video};
 use imitate::vocab::vocabulary::Vocabulary;
 use std::fmt::Write as _;
 use std::io::Write;
@@ -423,7 +424,7 @@ struct Decoding {
 impl Decoding {
     /// `None` when the video was decoded whole without complaint.
     fn of(probe: &VideoProbe, frames_read: usize, silhouettes: &Silhouettes) -> Option<Decoding> {
-        let failed = silhouettes.decoding_failed();
+        let failed = silhouettes.source().decoding_failed();
         let ended_early = failed.is_some() || probe.frames.is_some_and(|stated| frames_read + 1 < stated);
         let messages = failed.or(silhouettes.source().decoder_messages()).map(str::to_string);
         (ended_early || messages.is_some()).then_some(Decoding {

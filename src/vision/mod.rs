@@ -18,3 +18,4 @@ pub mod shape;
 pub mod sighting;
 pub mod silhouette;
 pub mod truth;
+pub mod video;

@@ -373,7 +373,7 @@ fn learned_params(learned: &LearnedBackground) -> ExtractParams {
 /// largest coherent region and what lies near it in size) is kept. A color
 /// frame whose silhouette covers more than [`MAX_PERSON_SHARE`] of it gives
 /// an empty one. A video whose decoding fails after its first frame ends
-/// there ([`Silhouettes::decoding_failed`] says why): the frames before the
+/// there ([`FrameSource::decoding_failed`] says why): the frames before the
 /// damage are still worth tracking.
 pub struct Silhouettes {
     source: FrameSource,
@@ -385,9 +385,6 @@ pub struct Silhouettes {
     background_used: Option<String>,
     learned: bool,
     unusable: usize,
-    /// Frames read from the source so far.
-    read: usize,
-    decoding_failed: Option<String>,
 }
 
 impl Silhouettes {
@@ -407,8 +404,6 @@ impl Silhouettes {
             background_used: None,
             learned: false,
             unusable: 0,
-            read: 0,
-            decoding_failed: None,
         }
     }
 
@@ -437,13 +432,8 @@ impl Silhouettes {
     pub fn next_seen(&mut self, mask: &mut Mask) -> Option<Result<Frame, SilhouetteError>> {
         let frame = match self.source.next_frame()? {
             Ok(frame) => self.shrinker.shrink(frame),
-            Err(e @ (FrameError::VideoFailed { .. } | FrameError::FfmpegIo { .. })) if self.read > 0 => {
-                self.decoding_failed = Some(e.to_string());
-                return None;
-            }
             Err(e) => return Some(Err(e.into())),
         };
-        self.read += 1;
         Some(self.extract(&frame, mask).map(|()| frame))
     }
 
@@ -499,12 +489,6 @@ impl Silhouettes {
     /// [`MAX_PERSON_SHARE`] of their area and were given as empty.
     pub fn unusable(&self) -> usize {
         self.unusable
-    }
-
-    /// Why the video stopped being decoded before its end (the decoder's
-    /// error, naming the file and the frames read), once it has.
-    pub fn decoding_failed(&self) -> Option<&str> {
-        self.decoding_failed.as_deref()
     }
 }
 
