@@ -2,7 +2,7 @@
 //! bytes for the same seed on any thread count, coasting over a frame with
 //! no silhouette, and bad input refused with nothing written.
 
-mod common;
+use crate::common;
 
 use common::{imitate, real_video_dir};
 use std::fs;

@@ -4,7 +4,7 @@
 //! loaded (a screenshot is kept), and bad input refused with nothing
 //! written.
 
-mod common;
+use crate::common;
 
 use common::{browser_check, imitate};
 use std::fs;

@@ -3,7 +3,7 @@
 //! late switches), the same bytes every time, and bad input is refused
 //! naming the file with nothing written.
 
-mod common;
+use crate::common;
 
 use common::{imitate, real_mocap_dir};
 use serde_json::Value;

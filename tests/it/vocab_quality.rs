@@ -2,7 +2,7 @@
 //! clusters against activity labels (never seen by learning), and each
 //! primitive's gradient field and progress on held-out repetitions.
 
-mod common;
+use crate::common;
 
 use imitate::vocab::corpus::{Corpus, load, read_labels};
 use imitate::vocab::evaluate::{

@@ -6,7 +6,7 @@
 //! never leaves the frame, a background learned from the frames finds them
 //! in every frame.
 
-mod common;
+use crate::common;
 
 use common::{imitate, real_mocap_dir, real_video_dir};
 use imitate::vision::frames::{Expect, FrameSource, read_image};

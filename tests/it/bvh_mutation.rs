@@ -2,7 +2,7 @@
 //! retargeter behind it) panic: every mutated file is read or refused with
 //! a message naming it. Seeded, so a failure reproduces everywhere.
 
-mod common;
+use crate::common;
 
 use imitate::mocap::bvh::read_bvh_bytes;
 use imitate::mocap::retarget::Retargeter;

@@ -2,7 +2,7 @@
 //! color frames and noise, the same bytes every time, and bad input refused
 //! with nothing written.
 
-mod common;
+use crate::common;
 
 use common::{imitate, real_mocap_dir};
 use imitate::vision::camera::Camera;

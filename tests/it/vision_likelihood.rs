@@ -2,7 +2,7 @@
 //! from the real captures, the true pose scores above almost every pose
 //! with one arm joint turned by 10°.
 
-mod common;
+use crate::common;
 
 use common::real_bvh_files;
 use glam::{DQuat, DVec3};

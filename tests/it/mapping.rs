@@ -4,8 +4,8 @@
 //! centimeters), and every real file in `../shared/mocap/`, by name and
 //! with its names taken away.
 
-mod common;
-#[path = "common/skeletons.rs"]
+use crate::common;
+#[path = "../common/skeletons.rs"]
 mod skeletons;
 
 use imitate::mocap::body::Joint;

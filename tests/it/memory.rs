@@ -2,7 +2,7 @@
 //! values. Measured in a separate `imitate inspect --timing` process, whose
 //! peak resident memory no other test shares.
 
-mod common;
+use crate::common;
 
 use imitate::mocap::bvh::write_bvh;
 use imitate::mocap::synth::{Activity, SynthOptions, activity_take};

@@ -3,7 +3,7 @@
 //! labels give; agreement with an independent reader (`bvh_anim`); and
 //! our writer's output read back by both readers.
 
-mod common;
+use crate::common;
 
 use glam::{DQuat, DVec3};
 use imitate::mocap::bvh::{Bvh, BvhErrorKind, Channel, read_bvh, read_bvh_bytes, write_bvh};

@@ -4,7 +4,7 @@
 //! falls reported, joint limits counted, and bad input refused with
 //! nothing written.
 
-mod common;
+use crate::common;
 
 use common::{imitate, real_bvh_files};
 use glam::DVec3;

@@ -1,7 +1,7 @@
 //! Retargeting onto the canonical humanoid: on every real capture, and on
 //! skeletons made here for the cases the real ones do not cover.
 
-mod common;
+use crate::common;
 
 use glam::{DQuat, DVec3};
 use imitate::mocap::body::{Body, Joint};

@@ -1,8 +1,6 @@
 //! The procedural demonstrator: smooth, inside joint limits, coordinated,
 //! varied, controllable and reproducible.
 
-mod common;
-
 use glam::DVec3;
 use imitate::mocap::body::{Joint, Kind, Proportions};
 use imitate::mocap::bvh::write_bvh;

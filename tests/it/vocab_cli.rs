@@ -5,7 +5,7 @@
 //! the README's command, and bad input is refused with one clear message,
 //! exit code 1 and nothing written.
 
-mod common;
+use crate::common;
 
 use common::{imitate, real_mocap_dir};
 use imitate::vocab::container::Container;

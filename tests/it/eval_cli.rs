@@ -2,7 +2,7 @@
 //! numbers equal to metrics.json's, the same numbers for the same seed, the
 //! page loading whole in headless Chromium, and bad input refused.
 
-mod common;
+use crate::common;
 
 use common::{browser_check, imitate, real_mocap_dir};
 use std::fs;

@@ -1,6 +1,6 @@
 //! The `imitate` command: subcommands, help, exit codes, outputs.
 
-mod common;
+use crate::common;
 
 use common::imitate;
 use std::fs;
