@@ -75,20 +75,27 @@ pub enum Outcome {
     SomeFailed,
 }
 
-/// A problem with the options themselves (exit code 2).
+/// A problem with the options themselves ([`EXIT_USAGE`]).
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
 pub struct UsageError(pub String);
+
+/// The exit code of a command that failed, or of one whose inputs partly
+/// failed (each reported), as docs/commands.md, "Exit codes", lists them.
+pub const EXIT_FAILED: u8 = 1;
+/// The exit code of options that cannot be used (as clap's own).
+pub const EXIT_USAGE: u8 = 2;
 
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = dispatch(cli);
     match result {
         Ok(Outcome::Success) => ExitCode::SUCCESS,
-        Ok(Outcome::SomeFailed) => ExitCode::from(1),
+        Ok(Outcome::SomeFailed) => ExitCode::from(EXIT_FAILED),
         Err(err) => {
             eprintln!("imitate: error: {}", describe(&err));
-            if err.downcast_ref::<UsageError>().is_some() { ExitCode::from(2) } else { ExitCode::from(1) }
+            let usage = err.downcast_ref::<UsageError>().is_some();
+            ExitCode::from(if usage { EXIT_USAGE } else { EXIT_FAILED })
         }
     }
 }
