@@ -293,7 +293,7 @@ impl Retargeter {
 
     /// Retargets every frame: in parallel, but for the hinge axes, which
     /// are carried from frame to frame ([`crate::mocap::hinge`]). A take
-    /// is solved in pieces of [`PIECE_FRAMES`], so the source frames each
+    /// is solved in pieces of `PIECE_FRAMES`, so the source frames each
     /// piece's passes share stay in cache and their buffers are reused.
     pub fn retarget(&self, bvh: &Bvh) -> Motion {
         let channels = bvh.channel_count();

@@ -314,7 +314,7 @@ impl Humanoid {
     /// of human balance. The correction moves the capture point (the centre
     /// of mass ahead by its velocity over the inverted pendulum's
     /// frequency, √(g/h)) onto the middle of the soles touching the ground,
-    /// up to [`BALANCE_MAX_RAD`] of tilt. Nothing changes while no foot
+    /// up to `BALANCE_MAX_RAD` of tilt. Nothing changes while no foot
     /// stands.
     pub fn balance(&self, targets: &mut [JointTarget; JOINTS]) {
         let standing: Vec<usize> = (0..2).filter(|&k| self.stands(FEET[k])).collect();

@@ -173,7 +173,7 @@ pub struct CameraEstimate {
     /// How far the person's distance varied over the frames, meters.
     pub depth_range_m: f64,
     /// `frames` when the person's changing distance fixed the height and
-    /// tilt. When they stood still within [`NEAR_M`], the cameras that see
+    /// tilt. When they stood still within `NEAR_M`, the cameras that see
     /// them alike were compared by how well the tracker explains the
     /// frames through each (`probes`, the prior's first): `likelihood` when
     /// one did clearly better than the prior's choice; else, and farther
@@ -465,7 +465,7 @@ fn quantile(values: &[f64], q: f64) -> f64 {
 
 /// How well the tracker explains `masks` through `camera`: the mean log R
 /// (eq. 8) of the frames' arbitrated estimates, once the filters have had
-/// [`LOCK_ON_FRAMES`] frames to lock on. The body is the one `params`
+/// `LOCK_ON_FRAMES` frames to lock on. The body is the one `params`
 /// start from; it is not fitted here.
 /// Also the likelihood evaluations it made.
 pub fn explained(vocabulary: &Vocabulary, camera: &Camera, masks: &[Mask], params: TrackParams) -> (f64, u64) {

@@ -232,7 +232,7 @@ impl CalibrationReport {
 #[derive(Clone, Debug)]
 pub struct Fit {
     /// Whether the build explains the frames better than the one it
-    /// started from by [`MIN_GAIN`].
+    /// started from by `MIN_GAIN`.
     pub accepted: bool,
     pub physique: Physique,
     /// The last sample's pose re-rooted for the fitted build.

@@ -108,7 +108,7 @@ pub struct Estimate {
     /// What recognition weighs this primitive by, on R's scale: the
     /// geometric mean of the estimate's R and the particles' prediction of
     /// the frame (the power mean of their R, to the sharpness, before they
-    /// are weighted: the filter's estimate of p(z[t] | z[1:t−1], primitive)).
+    /// are weighted: the filter's estimate of `p(z[t] | z[1:t−1], primitive)`).
     /// A primitive that fits the frame only with a pose its dynamics did
     /// not predict scores lower than one that saw it coming. `None` on a
     /// frame with no silhouette.

@@ -72,7 +72,7 @@ impl Judge {
 
     /// Adds a frame's keypoints to the window and weighs each site by how
     /// far (RMS about its mean in the window) it moved: in full from
-    /// `tolerance_px` on, [`STILL_WEIGHT`] when still.
+    /// `tolerance_px` on, `STILL_WEIGHT` when still.
     pub fn site_weights(&mut self, points: &SitePoints, tolerance_px: f64) -> [f64; 15] {
         self.points.push_back(about_hips(points));
         if self.points.len() > self.window {

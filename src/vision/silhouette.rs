@@ -655,7 +655,7 @@ impl Components {
 }
 
 /// The person in `mask`: its 8-connected regions of at least
-/// [`PERSON_SHARE`] of the largest one's area (specks set aside, a limb cut
+/// `PERSON_SHARE` of the largest one's area (specks set aside, a limb cut
 /// off by a thin gap kept); empty for an empty mask.
 pub fn person_region(mask: &Mask) -> Mask {
     let (width, height) = (mask.width(), mask.height());

@@ -240,7 +240,7 @@ pub fn root_classes(corpus: &Corpus, rows: &[SegmentRow]) -> Vec<RootClass> {
 /// cluster is first split by how the root moved around its segments
 /// ([`root_groups`]: joint space alone cannot tell a walk that turns from
 /// one that goes straight), then each part by the way its swings travel
-/// ([`direction_groups`]); each group is a primitive, named by its own
+/// (`direction_groups`); each group is a primitive, named by its own
 /// segments' majority label (a repeated name numbered).
 pub fn fit_primitives(
     corpus: &Corpus,
