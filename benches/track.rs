@@ -36,6 +36,7 @@ fn track(c: &mut Criterion) {
         .expect("the shipped vocabulary reads");
     vocabulary.retain(|p| PAPER.contains(&p.name()));
     assert_eq!(vocabulary.primitives().len(), PAPER.len(), "the shipped vocabulary has the paper's primitives");
+    let vocabulary = std::sync::Arc::new(vocabulary);
     let camera = Camera::preset(Preset::Front, 160, 120).expect("the front preset frames 160×120");
     let frames = silhouettes(&camera);
     let mut group = c.benchmark_group("track_frame");
@@ -52,7 +53,7 @@ fn track(c: &mut Criterion) {
             open_set: OpenSet::STANDARD,
             seed: 1,
         };
-        let mut tracker = Tracker::new(&vocabulary, camera.clone(), params).expect("valid settings");
+        let mut tracker = Tracker::new(vocabulary.clone(), camera.clone(), params).expect("valid settings");
         let mut k = 0;
         group.bench_function(BenchmarkId::new("4_primitives", particles), |b| {
             b.iter(|| {

@@ -28,6 +28,7 @@ use imitate::vocab::vocabulary::Vocabulary;
 use std::fmt::Write as _;
 use std::io::Write;
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Track a person through one camera with a vocabulary of primitives: one
@@ -155,12 +156,12 @@ impl Observe {
 }
 
 /// What follows the person: the primitives' filters, or the baseline.
-enum Follower<'v> {
-    Primitives(Box<Tracker<'v>>),
+enum Follower {
+    Primitives(Box<Tracker>),
     FullSpace(Box<FullSpaceFilter>),
 }
 
-impl Follower<'_> {
+impl Follower {
     /// The frame's pose, and the primitives' view of it when they track.
     fn step(&mut self, mask: &Mask, keypoints: Option<&SitePoints>) -> (Pose, Option<FrameEstimate>) {
         match self {
@@ -276,7 +277,7 @@ const PROBE_WIDTH: usize = 160;
 fn estimate_camera(
     args: &Args,
     silhouettes: &mut Silhouettes,
-    vocabulary: &Vocabulary,
+    vocabulary: &Arc<Vocabulary>,
     params: TrackParams,
     person: Person,
     pending: &mut Vec<Mask>,
@@ -498,7 +499,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     // made once the frames' rate is known.
     params(&args, DEFAULT_FPS)?;
     refuse_nonempty(&args.output, args.force)?;
-    let vocabulary = Vocabulary::load(&args.vocab)?;
+    let vocabulary = Arc::new(Vocabulary::load(&args.vocab)?);
     let source = FrameSource::open(&args.input, Expect::Auto)?;
     let probe = if source.is_video() { Some(probe_video(&args.input)?) } else { None };
     let (fps, rate_from) = frame_rate(&args, probe.as_ref())?;
@@ -550,8 +551,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             (camera, Some(estimate))
         }
     };
-    let tracker =
-        Tracker::new(&vocabulary, camera.clone(), params).with_context(|| args.vocab.display().to_string())?;
+    let tracker = Tracker::new(Arc::clone(&vocabulary), camera.clone(), params)
+        .with_context(|| args.vocab.display().to_string())?;
     let anneal = AnnealParams::with_budget(vocabulary.primitives().len() * params.filter.evaluations_per_frame());
     let mut follower = match args.baseline {
         None => Follower::Primitives(Box::new(tracker)),

@@ -31,6 +31,7 @@ use crate::vision::mask::Mask;
 use crate::vision::silhouette::person_region;
 use crate::vocab::vocabulary::Vocabulary;
 use glam::DVec3;
+use std::sync::Arc;
 
 /// Vertical fields of view `--fov` accepts, degrees.
 pub const FOV_DEG: (f64, f64) = (10.0, 150.0);
@@ -468,9 +469,10 @@ fn quantile(values: &[f64], q: f64) -> f64 {
 /// `LOCK_ON_FRAMES` frames to lock on. The body is the one `params`
 /// start from; it is not fitted here.
 /// Also the likelihood evaluations it made.
-pub fn explained(vocabulary: &Vocabulary, camera: &Camera, masks: &[Mask], params: TrackParams) -> (f64, u64) {
+pub fn explained(vocabulary: &Arc<Vocabulary>, camera: &Camera, masks: &[Mask], params: TrackParams) -> (f64, u64) {
     let held = params.calibration.map(|c| CalibrationParams { window_s: f64::MAX, give_up_s: f64::MAX, ..c });
-    let Ok(mut tracker) = Tracker::new(vocabulary, camera.clone(), TrackParams { calibration: held, ..params }) else {
+    let params = TrackParams { calibration: held, ..params };
+    let Ok(mut tracker) = Tracker::new(Arc::clone(vocabulary), camera.clone(), params) else {
         return (f64::MIN, 0);
     };
     let (mut total, mut counted, mut seen) = (0.0, 0usize, 0usize);

@@ -8,9 +8,11 @@ use crate::track::root::{Root, RootSearch};
 use crate::vision::scorer::{Fit, Scorer};
 use crate::vision::sighting::Sighting;
 use crate::vocab::primitive::Primitive;
+use crate::vocab::vocabulary::Vocabulary;
 use glam::DVec3;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
+use std::sync::Arc;
 
 /// The frame rate [`FilterParams::standard`] was tuned at (the paper's
 /// camera's).
@@ -118,8 +120,10 @@ pub struct Estimate {
 }
 
 /// The particles of one primitive and its global root.
-pub struct Filter<'v> {
-    primitive: &'v Primitive,
+pub struct Filter {
+    /// The vocabulary, shared, and which of its primitives this is.
+    vocabulary: Arc<Vocabulary>,
+    index: usize,
     params: FilterParams,
     /// Row-major, `particles × dims`.
     particles: Vec<f64>,
@@ -132,16 +136,19 @@ pub struct Filter<'v> {
     evaluations: u64,
 }
 
-impl<'v> Filter<'v> {
-    /// A filter whose particles start at random training poses of the
-    /// primitive (its manifold is the prior), with root `root`.
+impl Filter {
+    /// A filter of the vocabulary's primitive `index` whose particles
+    /// start at random training poses of it (its manifold is the prior),
+    /// with root `root`.
     pub fn new(
-        primitive: &'v Primitive,
+        vocabulary: Arc<Vocabulary>,
+        index: usize,
         params: FilterParams,
         root: Root,
         scorer: Scorer,
         mut rng: ChaCha8Rng,
     ) -> Self {
+        let primitive = &vocabulary.primitives()[index];
         let (d, field) = (primitive.dims(), primitive.field());
         let mut particles = Vec::with_capacity(params.particles * d);
         for _ in 0..params.particles {
@@ -150,7 +157,8 @@ impl<'v> Filter<'v> {
         }
         let weights = vec![1.0 / params.particles as f64; params.particles];
         Filter {
-            primitive,
+            vocabulary,
+            index,
             params,
             particles,
             weights,
@@ -163,7 +171,7 @@ impl<'v> Filter<'v> {
     }
 
     pub fn primitive(&self) -> &Primitive {
-        self.primitive
+        &self.vocabulary.primitives()[self.index]
     }
 
     pub fn set_root(&mut self, root: Root) {
@@ -181,13 +189,13 @@ impl<'v> Filter<'v> {
 
     /// One latent step of the primitive at the typical speed over a frame.
     fn step_length(&self) -> f64 {
-        self.primitive.speed().median * self.params.frame_time_s
+        self.primitive().speed().median * self.params.frame_time_s
     }
 
     /// The joint-space pose of particle `j`.
     fn particle_pose(&self, j: usize) -> JointVector {
-        let d = self.primitive.dims();
-        self.primitive.reconstruct(&self.particles[j * d..(j + 1) * d])
+        let d = self.primitive().dims();
+        self.primitive().reconstruct(&self.particles[j * d..(j + 1) * d])
     }
 
     /// What share of the frame `pose` accounts for (see [`Scorer::fit`]).
@@ -264,7 +272,7 @@ impl<'v> Filter<'v> {
         {
             return stay;
         }
-        let x = self.primitive.reconstruct(&self.mean());
+        let x = self.primitive().reconstruct(&self.mean());
         if self.score(sighting, &x, &moved) > self.score(sighting, &x, &stay) { moved } else { stay }
     }
 
@@ -276,22 +284,26 @@ impl<'v> Filter<'v> {
     /// the filter coasts: the particles move and the estimate is their
     /// mean.
     pub fn step(&mut self, sighting: Option<&Sighting>) -> Estimate {
-        let (d, n) = (self.primitive.dims(), self.params.particles);
+        // Its own handle on the vocabulary, so the primitive is borrowed
+        // while the particles change.
+        let vocabulary = Arc::clone(&self.vocabulary);
+        let primitive = &vocabulary.primitives()[self.index];
+        let (d, n) = (primitive.dims(), self.params.particles);
         let step = self.step_length();
-        let field = self.primitive.field();
+        let field = primitive.field();
         for j in 0..n {
             let y = &mut self.particles[j * d..(j + 1) * d];
             if self.rng.gen_bool(self.params.renewal) {
                 let i = self.rng.gen_range(0..field.len());
                 y.copy_from_slice(&field.points()[i * d..(i + 1) * d]);
             } else {
-                self.params.cone.sample(self.primitive, step, y, &mut self.rng, &mut self.cone);
+                self.params.cone.sample(primitive, step, y, &mut self.rng, &mut self.cone);
             }
         }
         let Some(sighting) = sighting else {
             self.weights.fill(1.0 / n as f64);
             let latent = self.mean();
-            let x = self.primitive.reconstruct(&latent);
+            let x = primitive.reconstruct(&latent);
             return self.estimate(latent, x, None, None);
         };
         let root = self.root;
@@ -307,14 +319,14 @@ impl<'v> Filter<'v> {
         let width = self.params.manifold * step;
         let mut nearest = Vec::with_capacity(1);
         for (j, (w, s)) in self.weights.iter_mut().zip(&scores).enumerate() {
-            let off = self.primitive.field().distance_to_data(&self.particles[j * d..(j + 1) * d], &mut nearest);
+            let off = primitive.field().distance_to_data(&self.particles[j * d..(j + 1) * d], &mut nearest);
             *w = (s / top).powf(k) * (-0.5 * (off / width).powi(2)).exp();
         }
         let total: f64 = self.weights.iter().sum();
         self.weights.iter_mut().for_each(|w| *w /= total);
         let best = (0..n).fold(0, |b, j| if self.weights[j] > self.weights[b] { j } else { b });
         let mean = self.mean();
-        let mean_x = self.primitive.reconstruct(&mean);
+        let mean_x = primitive.reconstruct(&mean);
         let mean_score = self.score(sighting, &mean_x, &root);
         let (latent, x, score) = if mean_score >= scores[best] {
             (mean, mean_x, mean_score)
@@ -330,13 +342,13 @@ impl<'v> Filter<'v> {
     }
 
     fn estimate(&self, latent: Vec<f64>, x: JointVector, likelihood: Option<f64>, evidence: Option<f64>) -> Estimate {
-        let progress = self.primitive.progress(&latent);
+        let progress = self.primitive().progress(&latent);
         Estimate { latent, root: self.root, x, likelihood, evidence, progress }
     }
 
     /// The weighted mean of the particles.
     fn mean(&self) -> Vec<f64> {
-        let d = self.primitive.dims();
+        let d = self.primitive().dims();
         let mut mean = vec![0.0; d];
         for (y, w) in self.particles.chunks_exact(d).zip(&self.weights) {
             mean.iter_mut().zip(y).for_each(|(m, v)| *m += w * v);
@@ -345,7 +357,7 @@ impl<'v> Filter<'v> {
     }
 
     fn resample(&mut self) {
-        let d = self.primitive.dims();
+        let d = self.primitive().dims();
         let mut next = Vec::with_capacity(self.particles.len());
         for j in systematic(&self.weights, &mut self.rng) {
             next.extend_from_slice(&self.particles[j * d..(j + 1) * d]);

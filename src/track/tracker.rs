@@ -18,6 +18,7 @@ use glam::DVec3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// Headings tried when a filter first places its root: silhouettes hardly
 /// tell which way a person faces, so every eighth of a turn is scored.
@@ -99,8 +100,9 @@ pub struct FrameEstimate {
     pub unexplained: bool,
 }
 
-pub struct Tracker<'v> {
-    filters: Vec<Filter<'v>>,
+pub struct Tracker {
+    vocabulary: Arc<Vocabulary>,
+    filters: Vec<Filter>,
     camera: Camera,
     physique: Physique,
     params: TrackParams,
@@ -114,8 +116,10 @@ pub struct Tracker<'v> {
     open_set: Judge,
 }
 
-impl<'v> Tracker<'v> {
-    pub fn new(vocabulary: &'v Vocabulary, camera: Camera, params: TrackParams) -> Result<Tracker<'v>, TrackError> {
+impl Tracker {
+    /// A tracker of `vocabulary`'s primitives (shared: a caller may hold
+    /// it too) through `camera`.
+    pub fn new(vocabulary: Arc<Vocabulary>, camera: Camera, params: TrackParams) -> Result<Tracker, TrackError> {
         if params.filter.particles == 0 {
             return Err(TrackError::NoParticles);
         }
@@ -137,18 +141,18 @@ impl<'v> Tracker<'v> {
         // Until a silhouette places it, the person stands where the camera looks.
         let look_at = DVec3::from_array(camera.spec().look_at);
         let root = Root { position: DVec3::new(look_at.x, body.pelvis_height(), look_at.z), heading: 0.0 };
-        let filters = primitives
-            .iter()
-            .enumerate()
-            .map(|(i, p)| {
+        let n = primitives.len();
+        let filters = (0..n)
+            .map(|i| {
                 // One stream per primitive, so threads cannot change the draws.
                 let rng = ChaCha8Rng::seed_from_u64(params.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ i as u64);
-                Filter::new(p, params.filter, root, Scorer::new(camera.clone(), body.clone()), rng)
+                let scorer = Scorer::new(camera.clone(), body.clone());
+                Filter::new(Arc::clone(&vocabulary), i, params.filter, root, scorer, rng)
             })
             .collect();
-        let n = primitives.len();
         let calibration = Calibrating::new(params.calibration, body.standing_height());
         Ok(Tracker {
+            vocabulary,
             filters,
             camera,
             physique,
@@ -160,6 +164,11 @@ impl<'v> Tracker<'v> {
             torso_px: None,
             open_set: Judge::new(params.open_set, params.filter.frame_time_s),
         })
+    }
+
+    /// The vocabulary whose primitives are tracked.
+    pub fn vocabulary(&self) -> &Arc<Vocabulary> {
+        &self.vocabulary
     }
 
     /// The skeleton drawn now (calibration changes it).
@@ -433,11 +442,11 @@ mod tests {
     use crate::vision::camera::Preset;
     use std::path::Path;
 
-    fn vocabulary() -> Vocabulary {
-        Vocabulary::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("vocab/default.vocab")).unwrap()
+    fn vocabulary() -> Arc<Vocabulary> {
+        Arc::new(Vocabulary::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("vocab/default.vocab")).unwrap())
     }
 
-    fn tracker(vocabulary: &Vocabulary, recognition: Recognition) -> Tracker<'_> {
+    fn tracker(vocabulary: &Arc<Vocabulary>, recognition: Recognition) -> Tracker {
         let filter = FilterParams {
             particles: 2,
             cone: Cone { lookahead: 1, spread: 0.5 },
@@ -450,7 +459,7 @@ mod tests {
         };
         let camera = Camera::preset(Preset::Front, 40, 30).unwrap();
         let params = TrackParams { filter, recognition, calibration: None, open_set: OpenSet::STANDARD, seed: 1 };
-        Tracker::new(vocabulary, camera, params).unwrap()
+        Tracker::new(Arc::clone(vocabulary), camera, params).unwrap()
     }
 
     /// Estimates whose likelihoods and evidence are `r` times a common factor.
