@@ -58,7 +58,7 @@ pub fn open_set(run: &Run, min_fit: f64) -> Option<Figure> {
         points: vec![line_point(0.0, min_fit), line_point(end, min_fit)],
     });
     // Unlabelled shading: the chart's title says what it is.
-    let flags = unexplained.iter().map(|v| v.filter(|v| *v > 0.5).map(|_| ""));
+    let flags = unexplained.iter().map(|v| (*v == Some(true)).then_some(""));
     let title = "share of the frame the best primitive accounts for (shaded: unexplained)";
     let shaded = spans(time, flags, 1.0 / run.summary.fps, |_| None);
     Some(Figure::new(WIDTH, 220, vec![shares_over_time(title, "fit", end, shaded, series)]))

@@ -57,10 +57,11 @@ pub struct Run {
     /// Each primitive's estimate's R (eq. 8), from `likelihoods.csv`;
     /// `None` for a baseline run, which writes none.
     pub likelihoods: Option<Curves>,
-    /// The open set: whether each frame was unexplained (1) or not (0),
-    /// and what share of it the best primitive accounted for (`fit_`
-    /// columns, by part); `None` for runs written before it.
-    pub unexplained: Option<Vec<Option<f64>>>,
+    /// The open set: whether each frame was unexplained (frames.csv's 1)
+    /// or not (0), `None` where it was not judged, and what share of it
+    /// the best primitive accounted for (`fit_` columns, by part);
+    /// `unexplained` is `None` for runs written before the open set.
+    pub unexplained: Option<Vec<Option<bool>>>,
     pub fits: Curves,
     pub summary: RunSummary,
 }
@@ -78,7 +79,8 @@ impl Run {
             .map_err(|e| ReportError::Summary { file: summary_path.display().to_string(), message: e.to_string() })?;
         let probabilities = table.prefixed("prob_")?;
         let progress = table.prefixed("progress_")?;
-        let (unexplained, fits) = (table.column("unexplained")?, table.prefixed("fit_")?);
+        let unexplained = table.column("unexplained")?.map(|c| c.into_iter().map(|v| v.map(|v| v > 0.5)).collect());
+        let fits = table.prefixed("fit_")?;
         let likelihoods = match summary.baseline {
             Some(_) => None,
             None => {
@@ -109,7 +111,7 @@ impl Run {
     /// primitives), and of them those unexplained.
     pub fn unexplained_frames(&self) -> Option<(usize, usize)> {
         let judged = self.unexplained.as_ref()?.iter().flatten();
-        Some(judged.fold((0, 0), |(all, unexplained), v| (all + 1, unexplained + usize::from(*v > 0.5))))
+        Some(judged.fold((0, 0), |(all, unexplained), &v| (all + 1, unexplained + usize::from(v))))
     }
 
     /// The primitives' names, in `frames.csv` order.

@@ -240,7 +240,6 @@ impl Video {
 
     fn decode(&mut self) -> Option<Result<Decoded, VideoError>> {
         self.stdout.as_ref()?;
-        let path = self.label.clone();
         let header = match self.pending.take() {
             Some((w, h)) => Ok(Header::Size(w, h)),
             None => self.read_header(),
@@ -252,7 +251,7 @@ impl Video {
                 self.note("the stream ended inside a frame header");
                 return self.finish().err().map(Err);
             }
-            Err(source) => return self.fail(VideoError::FfmpegIo { path, source }),
+            Err(source) => return self.fail(VideoError::FfmpegIo { path: self.label.clone(), source }),
         };
         let mut rgb = vec![0; width * height * 3];
         let stdout = self.stdout.as_mut().expect("checked above");
@@ -262,7 +261,7 @@ impl Video {
                 self.note(&format!("the stream ended {n} bytes into frame {}", self.frames));
                 return self.finish().err().map(Err);
             }
-            Err(source) => return self.fail(VideoError::FfmpegIo { path, source }),
+            Err(source) => return self.fail(VideoError::FfmpegIo { path: self.label.clone(), source }),
         }
         let index = self.frames;
         self.frames += 1;

@@ -253,11 +253,11 @@ fn credit(run: &Run, activity: &str) -> Credit {
 }
 
 /// [`credit`] of frames naming `named` primitives at `time_s`, each
-/// primitive's label in `label_of`, and those of them `unexplained` (1).
+/// primitive's label in `label_of`, and those of them `unexplained`.
 fn credit_frames(
     label_of: &BTreeMap<&str, &str>,
     named: &[Option<String>],
-    unexplained: &[Option<f64>],
+    unexplained: &[Option<bool>],
     time_s: &[f64],
     activity: &str,
 ) -> Credit {
@@ -273,7 +273,7 @@ fn credit_frames(
         };
         if t - *seen_since.get_or_insert(t) >= SETTLE_S {
             *counts.entry(label_of.get(named.as_str()).copied().unwrap_or(named).to_string()).or_default() += 1;
-            unexplained_frames += usize::from(unexplained.get(k).copied().flatten().is_some_and(|v| v > 0.5));
+            unexplained_frames += usize::from(unexplained.get(k).copied().flatten() == Some(true));
         }
     }
     let frames: usize = counts.values().sum();
@@ -312,9 +312,8 @@ mod tests {
             .collect();
         let time_s: Vec<f64> = (0..named.len()).map(|k| k as f64 / 10.0).collect();
         // The first three frames and the last two unexplained: two settled.
-        let unexplained: Vec<Option<f64>> = (0..named.len())
-            .map(|k| named[k].as_ref().map(|_| if k < 3 || k + 2 >= named.len() { 1.0 } else { 0.0 }))
-            .collect();
+        let unexplained: Vec<Option<bool>> =
+            (0..named.len()).map(|k| named[k].as_ref().map(|_| k < 3 || k + 2 >= named.len())).collect();
         let walk = credit_frames(&label_of, &named, &unexplained, &time_s, "walk");
         assert_eq!(walk.frames, 9);
         assert!((walk.labelled - 4.0 / 9.0).abs() < 1e-12, "{}", walk.labelled);
