@@ -7,6 +7,7 @@
 //!     taskset -c 0 cargo bench --bench execute      (one core)
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use imitate::params::Params;
 use imitate::sim::execute::{ExecuteParams, execute};
 use imitate::sim::humanoid::Base;
 use imitate::vocab::corpus;

@@ -16,6 +16,7 @@
 //!
 //! Labels only ever score; learning never sees them.
 
+use imitate::params::Params;
 use imitate::vocab::cluster::ClusterParams;
 use imitate::vocab::corpus::{Corpus, load, read_labels};
 use imitate::vocab::embed::EmbedParams;

@@ -11,8 +11,25 @@
 
 pub mod fsutil;
 pub mod mocap;
+pub mod params;
 pub mod report;
 pub mod sim;
 pub mod track;
 pub mod vision;
 pub mod vocab;
+
+/// An error and its causes in one line, leaving out a cause whose text the
+/// message already holds (errors that quote their source): how the CLI and
+/// Python print a library error.
+pub fn describe(err: &(dyn std::error::Error + 'static)) -> String {
+    let mut message = err.to_string();
+    let mut cause = err.source();
+    while let Some(c) = cause {
+        let text = c.to_string();
+        if !message.contains(&text) {
+            message = format!("{message}: {text}");
+        }
+        cause = c.source();
+    }
+    message
+}

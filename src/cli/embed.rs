@@ -1,14 +1,14 @@
 //! `imitate embed`: spatio-temporal Isomap over segments.
 
 use super::learn::EmbedArgs;
-use super::{Global, Outcome, count, note, progress};
+use super::{Global, Notes, Outcome, note, progress};
 use anyhow::Context;
 use imitate::fsutil::write_atomic;
 use imitate::vision::truth::quoted;
 use imitate::vocab::corpus::Corpus;
-use imitate::vocab::embed::ValidEmbedParams;
-use imitate::vocab::pipeline::{SegmentRow, embed_segments, segment_vectors};
-use imitate::vocab::stages::{Embedded, Segments};
+use imitate::vocab::learn::embed;
+use imitate::vocab::pipeline::{SegmentRow, segment_vectors};
+use imitate::vocab::stages::Segments;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -34,33 +34,6 @@ pub struct Args {
     pub vectors: Option<PathBuf>,
 }
 
-/// Embeds segments and says how.
-pub fn embed(
-    corpus: &Corpus,
-    mut segments: Segments,
-    params: &ValidEmbedParams,
-    global: Global,
-) -> anyhow::Result<Embedded> {
-    let embedding = embed_segments(corpus, &segments.rows, params)?;
-    let p = params.params();
-    let kind = if p.temporal {
-        format!(
-            "ST-Isomap, {} neighbours; {} adjacent and {} common temporal neighbour links shrunk",
-            p.neighbors, embedding.atn_edges, embedding.ctn_edges
-        )
-    } else {
-        format!("plain Isomap, {} neighbours", p.neighbors)
-    };
-    let joined = match embedding.joined_components {
-        0 => String::new(),
-        n => format!("; {n} separate pieces of the graph joined at their closest segments"),
-    };
-    let (segments_embedded, dims) = (count(embedding.len(), "segment"), count(embedding.dims(), "dimension"));
-    note(global, &format!("{segments_embedded} embedded in {dims} ({kind}{joined})"));
-    segments.lineage.embed = Some(p.clone());
-    Ok(Embedded { segments, embedding })
-}
-
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let params = args.embed.params()?;
     let context = || "`imitate embed` reads a segments table (from `imitate segment`)".to_string();
@@ -68,7 +41,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let bar = progress(global, 1, "read");
     let corpus = segments.load_motion(&args.segments)?;
     bar.finish_and_clear();
-    let embedded = embed(&corpus, segments, &params, global).with_context(|| args.segments.display().to_string())?;
+    let embedded =
+        embed(&corpus, segments, &params, &mut Notes(global)).with_context(|| args.segments.display().to_string())?;
     // Both files or neither.
     if let Some(path) = &args.vectors {
         write_vectors(path, &corpus, &embedded.segments.rows, params.params().resample)?;

@@ -6,6 +6,7 @@ use super::{Global, Outcome, UsageError, note, progress, refuse_nonempty};
 use anyhow::Context;
 use imitate::fsutil::{write_atomic, write_dir_atomic};
 use imitate::mocap::bvh::write_bvh;
+use imitate::params::{InvalidField, Params};
 use imitate::sim::execute::{ExecuteParams, ExecuteParamsError, Summary, bind_pose_start, execute};
 use imitate::sim::humanoid::{Base, Gains};
 use std::io::Write;
@@ -85,7 +86,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
                     ExecuteParamsError::Kp(_) | ExecuteParamsError::Kd(_) => format!("--gains {}", args.gains),
                     ExecuteParamsError::Rate(_) => format!("--rate {}", args.rate),
                 };
-                UsageError(format!("{flag}: {e}"))
+                UsageError(e.naming(&flag))
             })?;
     refuse_nonempty(&args.output, args.force)?;
     let (mut motion, _) = take(&args.input, None, &args.retarget, global)?;

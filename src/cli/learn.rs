@@ -3,8 +3,10 @@
 
 use super::UsageError;
 use super::retarget::RetargetArgs;
+use imitate::params::{InvalidField, Params};
 use imitate::vocab::cluster::{ClusterParams, ValidClusterParams};
 use imitate::vocab::eigen::EigenMethod;
+use imitate::vocab::learn::Takes;
 use imitate::vocab::embed::{EmbedParams, ValidEmbedParams};
 use imitate::vocab::primitive::{FitParams, ValidFitParams};
 use imitate::vocab::segment::{Method, SegmentParams, ValidSegmentParams};
@@ -24,6 +26,18 @@ pub struct TakesArgs {
     pub labels: Option<PathBuf>,
     #[command(flatten)]
     pub retarget: RetargetArgs,
+}
+
+impl TakesArgs {
+    /// The takes as the library reads them.
+    pub fn takes(&self) -> Takes {
+        Takes {
+            inputs: self.inputs.clone(),
+            labels: self.labels.clone(),
+            up: self.retarget.up.map(Into::into),
+            mapping: self.retarget.mapping.clone(),
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -85,7 +99,7 @@ impl SegmentArgs {
             dip_share: self.dip_share,
         }
         .check()
-        .map_err(|e| UsageError(e.to_string()))
+        .map_err(|e| usage(e, &[("min_excursion_m", "min-swing")]))
     }
 }
 
@@ -144,7 +158,7 @@ impl EmbedArgs {
             eigen,
         }
         .check()
-        .map_err(|e| UsageError(e.to_string()))
+        .map_err(|e| usage(e, &[]))
     }
 }
 
@@ -192,7 +206,7 @@ impl ClusterArgs {
             by_label: self.by_label,
         }
         .check()
-        .map_err(|e| UsageError(e.to_string()))
+        .map_err(|e| usage(e, &[]))
     }
 }
 
@@ -223,6 +237,18 @@ impl FitArgs {
             neighbors: self.field_neighbors,
         }
         .check()
-        .map_err(|e| UsageError(e.to_string()))
+        .map_err(|e| usage(e, &[("neighbors", "field-neighbors")]))
     }
+}
+
+/// A learning setting's error, naming the flag that set it: the flags are
+/// the params fields in kebab case without their unit, but for those
+/// `renamed` (field, flag).
+fn usage(e: impl InvalidField, renamed: &[(&str, &str)]) -> UsageError {
+    let field = e.field();
+    let flag = match renamed.iter().find(|(f, _)| *f == field) {
+        Some((_, flag)) => flag.to_string(),
+        None => field.trim_end_matches("_s").replace('_', "-"),
+    };
+    UsageError(e.naming(&format!("--{flag}")))
 }

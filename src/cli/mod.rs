@@ -136,16 +136,32 @@ fn dispatch(cli: Cli) -> anyhow::Result<Outcome> {
 }
 
 /// An error and its causes in one line, leaving out a cause whose text the
-/// message already holds (errors that quote their source).
+/// message already holds (errors that quote their source), and ending with
+/// the flag to change where the library's words name only a setting.
 fn describe(err: &anyhow::Error) -> String {
-    let mut message = err.to_string();
-    for cause in err.chain().skip(1) {
-        let text = cause.to_string();
-        if !message.contains(&text) {
-            message = format!("{message}: {text}");
-        }
+    let message = imitate::describe(err.as_ref());
+    match err.chain().find_map(flag_hint) {
+        Some(hint) if message.contains('\n') => format!("{message}\n({hint})"),
+        Some(hint) => format!("{message} ({hint})"),
+        None => message,
     }
-    message
+}
+
+/// The flag behind a library error that a setting caused but only the data
+/// could refuse (so no params check names it).
+fn flag_hint(cause: &(dyn std::error::Error + 'static)) -> Option<String> {
+    use imitate::mocap::retarget::RetargetError;
+    use imitate::vocab::cluster::ClusterError;
+    use imitate::vocab::pipeline::BuildError;
+    let cluster = cause.downcast_ref::<ClusterError>().or(match cause.downcast_ref::<BuildError>() {
+        Some(BuildError::Cluster(e)) => Some(e),
+        _ => None,
+    });
+    if let Some(ClusterError::TooManyClusters { k, .. }) = cluster {
+        return Some(format!("lower --k {k}, or leave it out to choose k by silhouette"));
+    }
+    matches!(cause.downcast_ref::<RetargetError>(), Some(RetargetError::Unmapped { .. }))
+        .then(|| "pass the mapping file with --map FILE".to_string())
 }
 
 /// A progress bar on stderr, hidden when stderr is not a terminal or with
@@ -182,15 +198,21 @@ pub fn peak_resident_mb() -> Option<f64> {
     Some(kb * 1024.0 / 1e6)
 }
 
-/// `1 take`, `3 takes`.
-pub fn count(n: usize, noun: &str) -> String {
-    if n == 1 { format!("1 {noun}") } else { format!("{n} {noun}s") }
-}
+pub use imitate::vocab::learn::count;
 
 /// Prints a note on stderr unless `--quiet`.
 pub fn note(global: Global, text: &str) {
     if !global.quiet {
         eprintln!("{text}");
+    }
+}
+
+/// A learning stage's notes, on stderr unless `--quiet`.
+pub struct Notes(pub Global);
+
+impl imitate::vocab::learn::Listener for Notes {
+    fn note(&mut self, text: &str) {
+        note(self.0, text);
     }
 }
 

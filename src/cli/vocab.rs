@@ -3,10 +3,10 @@
 
 use super::learn::{ClusterArgs, EmbedArgs, FitArgs, SegmentArgs, TakesArgs};
 use super::{Global, Outcome, count, note, peak_resident_mb, write_stdout};
-use anyhow::Context;
 use imitate::vocab::cluster::Choice;
 use imitate::vocab::container::FORMAT_VERSION;
-use imitate::vocab::lineage::Lineage;
+use imitate::vocab::learn::{self, Built, Listener};
+use imitate::vocab::pipeline::BuildParams;
 use imitate::vocab::vocabulary::Vocabulary;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -64,16 +64,31 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     }
 }
 
-/// A spinner for one stage on stderr, finished with the stage's time.
-struct Stage {
-    bar: ProgressBar,
-    name: &'static str,
-    started: Instant,
+/// A spinner per stage on stderr, each stage's time kept.
+struct Stages {
+    global: Global,
+    running: Option<(ProgressBar, &'static str, Instant)>,
+    times: Vec<(&'static str, f64)>,
 }
 
-impl Stage {
-    fn start(global: Global, name: &'static str) -> Stage {
-        let bar = if global.quiet || !std::io::stderr().is_terminal() {
+impl Stages {
+    fn new(global: Global) -> Stages {
+        Stages { global, running: None, times: Vec::new() }
+    }
+
+    /// Ends the running stage, if any, keeping its time.
+    fn finish(&mut self) {
+        if let Some((bar, name, started)) = self.running.take() {
+            self.times.push((name, started.elapsed().as_secs_f64()));
+            bar.finish_and_clear();
+        }
+    }
+}
+
+impl Listener for Stages {
+    fn stage(&mut self, name: &'static str) {
+        self.finish();
+        let bar = if self.global.quiet || !std::io::stderr().is_terminal() {
             ProgressBar::hidden()
         } else {
             let bar = ProgressBar::new_spinner().with_message(name);
@@ -83,49 +98,37 @@ impl Stage {
             bar.enable_steady_tick(Duration::from_millis(100));
             bar
         };
-        Stage { bar, name, started: Instant::now() }
+        self.running = Some((bar, name, Instant::now()));
     }
 
-    fn finish(self) -> (&'static str, f64) {
-        let seconds = self.started.elapsed().as_secs_f64();
-        self.bar.finish_and_clear();
-        (self.name, seconds)
+    fn note(&mut self, text: &str) {
+        match &self.running {
+            Some((bar, ..)) if !self.global.quiet => bar.suspend(|| eprintln!("{text}")),
+            _ => note(self.global, text),
+        }
     }
 }
 
 fn build(args: BuildArgs, global: Global) -> anyhow::Result<Outcome> {
-    let (segment_params, embed_params) = (args.segment.params()?, args.embed.params()?);
-    let (cluster_params, fit_params) = (args.cluster.params()?, args.fit.params()?);
-    let (takes, settings) = (&args.takes, args.takes.retarget.settings());
-    let mut times = Vec::new();
-
-    let stage = Stage::start(global, "read");
-    let options = takes.retarget.options()?;
-    let corpus = super::segment::load_corpus(&takes.inputs, takes.labels.as_deref(), &options, global)?;
-    times.push(stage.finish());
-    let stage = Stage::start(global, "segment");
-    let lineage = Lineage::new(settings, segment_params.params().clone());
-    let from = || super::segment::takes_named(&corpus);
-    let segments = super::segment::segment(&corpus, &segment_params, lineage, global)?;
-    times.push(stage.finish());
-    let stage = Stage::start(global, "embed");
-    let embedded = super::embed::embed(&corpus, segments, &embed_params, global).with_context(from)?;
-    times.push(stage.finish());
-    let stage = Stage::start(global, "cluster");
-    let clustered = super::cluster::cluster(embedded, &cluster_params, global).with_context(from)?;
-    times.push(stage.finish());
-    let stage = Stage::start(global, "fit");
-    let mut vocabulary = super::fit::fit(&corpus, &clustered, &fit_params, global).with_context(from)?;
-    times.push(stage.finish());
-    let stage = Stage::start(global, "write");
+    let params = BuildParams {
+        segment: args.segment.params()?,
+        embed: args.embed.params()?,
+        cluster: args.cluster.params()?,
+        fit: args.fit.params()?,
+    };
+    let mut stages = Stages::new(global);
+    let built = learn::build(&args.takes.takes(), &params, &mut stages);
+    stages.finish();
+    let Built { mut vocabulary, frames } = built?;
+    stages.stage("write");
     vocabulary.save(&args.output)?;
-    times.push(stage.finish());
+    stages.finish();
 
     note(global, &saved(&vocabulary, &args.output));
-    let total: f64 = times.iter().map(|t| t.1).sum();
-    let each: Vec<String> = times.iter().map(|(name, s)| format!("{name} {s:.2} s")).collect();
+    let total: f64 = stages.times.iter().map(|t| t.1).sum();
+    let each: Vec<String> = stages.times.iter().map(|(name, s)| format!("{name} {s:.2} s")).collect();
     let memory = peak_resident_mb().map_or(String::new(), |mb| format!("; peak memory {mb:.0} MB"));
-    note(global, &format!("time: {}; total {total:.2} s for {} frames{memory}", each.join(", "), corpus.frames()));
+    note(global, &format!("time: {}; total {total:.2} s for {frames} frames{memory}", each.join(", ")));
     Ok(Outcome::Success)
 }
 
@@ -145,14 +148,8 @@ fn info(args: InfoArgs) -> anyhow::Result<Outcome> {
     let vocabulary = Vocabulary::load(&args.file)?;
     let bytes = std::fs::metadata(&args.file).map_or(0, |m| m.len());
     let checksum = format!("{:#010x}", vocabulary.checksum().unwrap_or(0));
-    let (header, _) = vocabulary.to_parts();
     let text = if args.json {
-        let mut value = serde_json::to_value(&header).expect("the header serializes");
-        let object = value.as_object_mut().expect("the header is an object");
-        object.insert("file".into(), args.file.display().to_string().into());
-        object.insert("format_version".into(), FORMAT_VERSION.into());
-        object.insert("bytes".into(), bytes.into());
-        object.insert("checksum".into(), checksum.into());
+        let value = vocabulary.info(Some(&args.file), Some(vocabulary.checksum().unwrap_or(0)));
         serde_json::to_string_pretty(&value).expect("JSON serializes") + "\n"
     } else {
         describe(&vocabulary, &args.file, bytes, &checksum)
@@ -213,7 +210,7 @@ fn describe(vocabulary: &Vocabulary, path: &Path, bytes: u64, checksum: &str) ->
         out.push(format!("  left out (no motion): {}", b.still.join(", ")));
     }
     out.push(String::new());
-    out.push(super::fit::summary(vocabulary));
+    out.push(learn::summary(vocabulary));
     out.push(String::new());
     for p in vocabulary.primitives() {
         let mut files: Vec<(&str, usize)> = Vec::new();

@@ -92,7 +92,7 @@ fn unmapped_message(scheme: &str, missing: &[&str], joints: &str, structure: &Op
     let structure = structure.as_ref().map(|why| format!("; its structure gives no body: {why}")).unwrap_or_default();
     format!(
         "cannot map the skeleton onto the canonical body: no source joint for {} (closest built-in naming scheme: {scheme}{structure}).\n\
-         Write a mapping file naming the source joint for each, and pass it with --map:\n\
+         Write a mapping file naming the source joint for each (docs/formats.md, \"Mapping files\"), and give it as the mapping:\n\
          \n    # mapping.toml: canonical joint = source joint; {{ end_of = \"J\" }} names J's End Site\n{example}\n\
          The skeleton's joints are: {joints}",
         missing.join(", ")
@@ -511,7 +511,7 @@ impl Retargeter {
         a.meters_per_unit = meters_per_unit;
 
         if a.up_axis != "+Y" {
-            let how = if a.up_detected { "detected from the skeleton" } else { "set by --up" };
+            let how = if a.up_detected { "detected from the skeleton" } else { "as given" };
             let message = format!("the capture stands along {} ({how}); it is turned to stand along +Y", a.up_axis);
             a.warnings.push(Warning { code: "up_axis", message });
         }

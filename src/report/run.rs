@@ -4,48 +4,8 @@
 
 use super::metrics::{Primitives, ReportError, Track};
 use super::{Curves, Table, read_primitives, read_track};
-use crate::vision::camera::CameraSpec;
+use crate::track::run::RunSummary;
 use std::path::{Path, PathBuf};
-
-/// What `summary.json` says that reports show.
-#[derive(Clone, Debug, serde::Deserialize)]
-pub struct RunSummary {
-    /// The frames tracked, as given to `track`.
-    pub input: String,
-    /// The camera, in the frames' own pixels.
-    pub camera: CameraSpec,
-    /// The size frames were reduced to for tracking; absent in runs
-    /// written before `--work-size`, which tracked at the camera's size.
-    #[serde(default)]
-    pub work_size: Option<[usize; 2]>,
-    /// The background color frames were compared with: an image's path,
-    /// or what it was learned from.
-    #[serde(default)]
-    pub background: Option<String>,
-    pub fps: f64,
-    pub frames: usize,
-    pub seed: u64,
-    pub likelihood_evaluations_per_frame: f64,
-    pub timing: Timing,
-    /// The tracker's settings, as written.
-    pub settings: serde_json::Value,
-    #[serde(default)]
-    pub baseline: Option<serde_json::Value>,
-}
-
-impl RunSummary {
-    /// The background image the run was given, if it was one (and is still
-    /// there), to make its silhouettes again.
-    pub fn background_plate(&self) -> Option<PathBuf> {
-        self.background.as_ref().map(PathBuf::from).filter(|p| p.is_file())
-    }
-}
-
-#[derive(Clone, Debug, serde::Deserialize)]
-pub struct Timing {
-    pub seconds: f64,
-    pub frames_per_second: f64,
-}
 
 pub struct Run {
     pub dir: PathBuf,

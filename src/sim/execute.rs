@@ -9,6 +9,7 @@ use crate::fsutil::{round6, rounded};
 use crate::mocap::body::{JOINTS, Joint, Kind};
 use crate::mocap::math::angle_between;
 use crate::mocap::pose::{Motion, Pose};
+use crate::params::{InvalidField, Params};
 use glam::{DQuat, DVec3};
 use std::fmt::Write;
 
@@ -37,19 +38,33 @@ pub struct ValidExecuteParams(ExecuteParams);
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum ExecuteParamsError {
-    #[error("the stiffness gain must be a positive number (1/s²), not {0}")]
+    #[error("gains: the stiffness gain must be a positive number (1/s²), not {0}")]
     Kp(f64),
-    #[error("the damping gain must be a positive number (1/s), not {0}")]
+    #[error("gains: the damping gain must be a positive number (1/s), not {0}")]
     Kd(f64),
-    #[error("the physics rate must be a number of steps a second in (0, {max}], not {0}", max = ExecuteParams::MAX_RATE_HZ)]
+    #[error("rate_hz: the physics rate must be a number of steps a second in (0, {max}], not {0}", max = ExecuteParams::MAX_RATE_HZ)]
     Rate(f64),
+}
+
+impl InvalidField for ExecuteParamsError {
+    fn field(&self) -> &'static str {
+        match self {
+            ExecuteParamsError::Kp(_) | ExecuteParamsError::Kd(_) => "gains",
+            ExecuteParamsError::Rate(_) => "rate_hz",
+        }
+    }
 }
 
 impl ExecuteParams {
     /// Beyond this a step is shorter than rapier's f32 time resolves well.
     pub const MAX_RATE_HZ: f64 = 100_000.0;
+}
 
-    pub fn check(self) -> Result<ValidExecuteParams, ExecuteParamsError> {
+impl Params for ExecuteParams {
+    type Valid = ValidExecuteParams;
+    type Error = ExecuteParamsError;
+
+    fn check(&self) -> Result<ValidExecuteParams, ExecuteParamsError> {
         let Gains { kp_per_s2: kp, kd_per_s: kd } = self.gains;
         if !(kp.is_finite() && kp > 0.0) {
             return Err(ExecuteParamsError::Kp(kp));
@@ -60,7 +75,7 @@ impl ExecuteParams {
         if !(self.rate_hz.is_finite() && self.rate_hz > 0.0 && self.rate_hz <= Self::MAX_RATE_HZ) {
             return Err(ExecuteParamsError::Rate(self.rate_hz));
         }
-        Ok(ValidExecuteParams(self))
+        Ok(ValidExecuteParams(*self))
     }
 }
 

@@ -10,8 +10,10 @@
 pub mod auto_camera;
 pub mod baseline;
 pub mod calibrate;
+pub mod clip;
 pub mod cone;
 pub mod filter;
 pub mod open_set;
 pub mod root;
+pub mod run;
 pub mod tracker;

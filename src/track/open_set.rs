@@ -1,6 +1,7 @@
 //! The open set: frames whose activity the vocabulary does not hold are
 //! reported unexplained, not forced onto the nearest primitive.
 
+use crate::params::{InvalidField, Params};
 use crate::vision::keypoints::{Site, SitePoints};
 use crate::vision::scorer::{Fit, Share};
 use std::collections::VecDeque;
@@ -30,24 +31,38 @@ impl OpenSet {
     /// than half, or puts fewer than half the (moving) keypoints within
     /// PCK@0.2's tolerance, is not the person's; over half a second.
     pub const STANDARD: OpenSet = OpenSet { min_fit: 0.5, window_s: 0.5 };
+}
 
-    pub fn check(&self) -> Result<(), OpenSetError> {
+impl Params for OpenSet {
+    type Valid = OpenSet;
+    type Error = OpenSetError;
+
+    fn check(&self) -> Result<OpenSet, OpenSetError> {
         if !(0.0..=1.0).contains(&self.min_fit) {
             return Err(OpenSetError::MinFit(self.min_fit));
         }
         if !(self.window_s.is_finite() && self.window_s > 0.0) {
             return Err(OpenSetError::Window(self.window_s));
         }
-        Ok(())
+        Ok(*self)
     }
 }
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum OpenSetError {
-    #[error("the open set's min_fit is a share in [0, 1], not {0}")]
+    #[error("min_fit: the share of a frame its best primitive must explain lies in [0, 1], not {0}")]
     MinFit(f64),
-    #[error("the open set's window_s is a positive number of seconds, not {0}")]
+    #[error("window_s: the open set's window is a positive number of seconds, not {0}")]
     Window(f64),
+}
+
+impl InvalidField for OpenSetError {
+    fn field(&self) -> &'static str {
+        match self {
+            OpenSetError::MinFit(_) => "min_fit",
+            OpenSetError::Window(_) => "window_s",
+        }
+    }
 }
 
 /// A still point's weight against a moving one's 1: enough that a person
@@ -178,6 +193,6 @@ mod tests {
         assert_eq!(OpenSet { min_fit: 1.5, ..OpenSet::STANDARD }.check(), Err(OpenSetError::MinFit(1.5)));
         assert_eq!(OpenSet { window_s: 0.0, ..OpenSet::STANDARD }.check(), Err(OpenSetError::Window(0.0)));
         assert!(OpenSet { min_fit: f64::NAN, ..OpenSet::STANDARD }.check().is_err());
-        assert_eq!(OpenSet::STANDARD.check(), Ok(()));
+        assert_eq!(OpenSet::STANDARD.check(), Ok(OpenSet::STANDARD));
     }
 }

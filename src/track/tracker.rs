@@ -4,6 +4,7 @@
 
 use crate::mocap::body::Body;
 use crate::mocap::pose::Pose;
+use crate::params::{InvalidField, Params};
 use crate::track::calibrate::{self, CalibrationParams, CalibrationReport, HeightFrom, Physique, Sample, blend};
 use crate::track::filter::{Estimate, Filter, FilterParams};
 use crate::track::open_set::{Judge, OpenSet, OpenSetError};
@@ -66,17 +67,56 @@ pub struct TrackParams {
     pub seed: u64,
 }
 
+impl Params for TrackParams {
+    type Valid = TrackParams;
+    type Error = TrackParamsError;
+
+    fn check(&self) -> Result<TrackParams, TrackParamsError> {
+        if self.filter.particles == 0 {
+            return Err(TrackParamsError::Particles);
+        }
+        if self.filter.cone.lookahead == 0 {
+            return Err(TrackParamsError::Lookahead);
+        }
+        let frame_time_s = self.filter.frame_time_s;
+        if !(frame_time_s.is_finite() && frame_time_s > 0.0) {
+            return Err(TrackParamsError::FrameTime(frame_time_s));
+        }
+        self.open_set.check()?;
+        Ok(*self)
+    }
+}
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum TrackParamsError {
+    #[error("particles: a filter needs at least 1 particle")]
+    Particles,
+    #[error("lookahead: the bending cone needs at least 1 prediction")]
+    Lookahead,
+    #[error("frame_time_s: a frame lasts a positive number of seconds, not {0}")]
+    FrameTime(f64),
+    #[error(transparent)]
+    OpenSet(#[from] OpenSetError),
+}
+
+impl InvalidField for TrackParamsError {
+    fn field(&self) -> &'static str {
+        match self {
+            TrackParamsError::Particles => "particles",
+            TrackParamsError::Lookahead => "lookahead",
+            TrackParamsError::FrameTime(_) => "frame_time_s",
+            TrackParamsError::OpenSet(e) => e.field(),
+        }
+    }
+}
+
 /// Why a tracker cannot be set up.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum TrackError {
-    #[error("--particles must be at least 1")]
-    NoParticles,
-    #[error("--lookahead must be at least 1")]
-    NoLookahead,
+    #[error(transparent)]
+    Params(#[from] TrackParamsError),
     #[error("the vocabulary has no primitives")]
     EmptyVocabulary,
-    #[error(transparent)]
-    OpenSet(#[from] OpenSetError),
 }
 
 /// One frame's outcome.
@@ -120,17 +160,11 @@ impl Tracker {
     /// A tracker of `vocabulary`'s primitives (shared: a caller may hold
     /// it too) through `camera`.
     pub fn new(vocabulary: Arc<Vocabulary>, camera: Camera, params: TrackParams) -> Result<Tracker, TrackError> {
-        if params.filter.particles == 0 {
-            return Err(TrackError::NoParticles);
-        }
-        if params.filter.cone.lookahead == 0 {
-            return Err(TrackError::NoLookahead);
-        }
+        params.check()?;
         let primitives = vocabulary.primitives();
         if primitives.is_empty() {
             return Err(TrackError::EmptyVocabulary);
         }
-        params.open_set.check()?;
         // A held height is drawn from the first frame; a fitted one from
         // the first fit.
         let physique = match params.calibration.and_then(|c| c.held_height()) {

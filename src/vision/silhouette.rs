@@ -9,6 +9,7 @@
 //! found over runs of pixels rather than pixel by pixel. An [`Extractor`]
 //! keeps its scratch buffers, so after the first frame it allocates nothing.
 
+use crate::params::{InvalidField, Params};
 use crate::vision::background::{LearnedBackground, learn_background};
 use crate::vision::frames::{Frame, FrameError, FrameKind, FrameSource, beside_frames, read_image};
 use crate::vision::mask::Mask;
@@ -39,18 +40,31 @@ pub enum SilhouetteError {
 /// A setting of [`ExtractParams`] out of its range.
 #[derive(Debug, Error, PartialEq)]
 pub enum ExtractParamsError {
-    #[error("the difference threshold must be 1 to 764 (a sum over three channels of 0 to 255), not {0}")]
+    #[error("threshold: the difference threshold must be 1 to 764 (a sum over three channels of 0 to 255), not {0}")]
     Threshold(u16),
-    #[error("the shadow brightness ratios must satisfy 0 < low ≤ high < 1, not {low} and {high}")]
+    #[error("shadow_low: the shadow brightness ratios must satisfy 0 < low ≤ high < 1, not {low} and {high}")]
     ShadowRatio { low: f32, high: f32 },
-    #[error("the shadow color tolerance must be at most 765, not {0}")]
+    #[error("shadow_chroma: the shadow color tolerance must be at most 765, not {0}")]
     ShadowChroma(u16),
-    #[error("the median filter radius must be at most {MAX_MEDIAN_RADIUS}, not {0}")]
+    #[error("median_radius: the median filter radius must be at most {MAX_MEDIAN_RADIUS}, not {0}")]
     MedianRadius(usize),
-    #[error("the smallest blob must be a fraction of the image in [0, 1), not {0}")]
+    #[error("min_blob: the smallest blob must be a fraction of the image in [0, 1), not {0}")]
     MinBlob(f64),
-    #[error("the largest hole filled must be a fraction of the image in [0, 1), not {0}")]
+    #[error("max_hole: the largest hole filled must be a fraction of the image in [0, 1), not {0}")]
     MaxHole(f64),
+}
+
+impl InvalidField for ExtractParamsError {
+    fn field(&self) -> &'static str {
+        match self {
+            ExtractParamsError::Threshold(_) => "threshold",
+            ExtractParamsError::ShadowRatio { .. } => "shadow_low",
+            ExtractParamsError::ShadowChroma(_) => "shadow_chroma",
+            ExtractParamsError::MedianRadius(_) => "median_radius",
+            ExtractParamsError::MinBlob(_) => "min_blob",
+            ExtractParamsError::MaxHole(_) => "max_hole",
+        }
+    }
 }
 
 /// Settings of background subtraction and cleaning; each setter takes and
@@ -128,8 +142,13 @@ impl ExtractParams {
         self.max_hole = fraction;
         self
     }
+}
 
-    fn check(&self) -> Result<(), ExtractParamsError> {
+impl Params for ExtractParams {
+    type Valid = ExtractParams;
+    type Error = ExtractParamsError;
+
+    fn check(&self) -> Result<ExtractParams, ExtractParamsError> {
         if !(1..=764).contains(&self.threshold) {
             return Err(ExtractParamsError::Threshold(self.threshold));
         }
@@ -149,7 +168,7 @@ impl ExtractParams {
         if !(0.0..1.0).contains(&self.max_hole) {
             return Err(ExtractParamsError::MaxHole(self.max_hole));
         }
-        Ok(())
+        Ok(*self)
     }
 }
 

@@ -11,6 +11,7 @@ pub mod embed;
 pub mod evaluate;
 pub mod holdout;
 pub mod knn;
+pub mod learn;
 pub mod lineage;
 pub mod metrics;
 pub mod pca;

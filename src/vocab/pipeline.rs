@@ -2,6 +2,7 @@
 //! each stage's subcommand runs one step of.
 
 use crate::mocap::body::DOF;
+use crate::params::Params;
 use crate::vocab::cluster::{ClusterError, Clustering, ValidClusterParams};
 use crate::vocab::corpus::{Corpus, Recording};
 use crate::vocab::embed::{EmbedError, Embedding, ValidEmbedParams, resample};

@@ -264,6 +264,13 @@ impl Vocabulary {
 
     /// Writes the `.vocab` file (atomically).
     pub fn save(&mut self, path: &Path) -> Result<(), VocabError> {
+        self.checksum = Some(self.write(path)?);
+        Ok(())
+    }
+
+    /// Writes the `.vocab` file (atomically) and returns its CRC-32, for a
+    /// caller that shares the vocabulary and so cannot change it.
+    pub fn write(&self, path: &Path) -> Result<u32, VocabError> {
         let (header, arrays) = self.to_parts();
         let value = serde_json::to_value(&header).expect("the header serializes");
         let mut container = Container::new(value);
@@ -275,8 +282,27 @@ impl Vocabulary {
         let bytes = container.to_bytes().expect("a vocabulary header is an object with unique array names");
         write_atomic(path, |out| out.write_all(&bytes))
             .map_err(|e| VocabError::Write { path: path.display().to_string(), source: e })?;
-        self.checksum = Some(trailing_checksum(&bytes));
-        Ok(())
+        Ok(trailing_checksum(&bytes))
+    }
+
+    /// What `vocab info --json` prints: the header, the format version,
+    /// and the file it was read from or written to with its size and
+    /// `checksum` (when there is one).
+    pub fn info(&self, file: Option<&Path>, checksum: Option<u32>) -> serde_json::Value {
+        let (header, _) = self.to_parts();
+        let mut value = serde_json::to_value(&header).expect("the header serializes");
+        let object = value.as_object_mut().expect("the header is an object");
+        if let Some(file) = file {
+            object.insert("file".into(), file.display().to_string().into());
+        }
+        object.insert("format_version".into(), crate::vocab::container::FORMAT_VERSION.into());
+        if let Some(file) = file {
+            object.insert("bytes".into(), std::fs::metadata(file).map_or(0, |m| m.len()).into());
+        }
+        if let Some(checksum) = checksum {
+            object.insert("checksum".into(), format!("{checksum:#010x}").into());
+        }
+        value
     }
 
     /// Reads a `.vocab` file, refusing one that is truncated, corrupt,

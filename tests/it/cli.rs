@@ -199,6 +199,8 @@ fn a_skeleton_without_arms_is_an_error_that_shows_the_mapping_file_to_write() {
     assert!(err.starts_with(&format!("imitate: error: {}: cannot map the skeleton", input.display())), "{err}");
     assert!(err.contains("its structure gives no body: it has 0 limbs"), "{err}");
     assert!(err.contains("left_elbow = \"<source joint name>\"") && err.contains("Base, Mid, Top"), "{err}");
+    // The library says what to write; the command says which flag takes it.
+    assert!(err.trim_end().ends_with("(pass the mapping file with --map FILE)"), "{err}");
     assert!(!output.exists());
 }
 

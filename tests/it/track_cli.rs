@@ -225,7 +225,12 @@ fn bad_input_is_refused_with_nothing_written() {
     refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--height", "0.5"], 2, "--height 0.5");
     refused(dir, &["track", frames, "--vocab", vocab, "-o", "out", "--fps", "0"], 2, "--fps 0");
     let share = ["track", frames, "--vocab", vocab, "-o", "out", "--unexplained-below", "1.5"];
-    refused(dir, &share, 2, "--unexplained-below 1.5: the open set's min_fit is a share in [0, 1]");
+    refused(
+        dir,
+        &share,
+        2,
+        "--unexplained-below 1.5: the share of a frame its best primitive must explain lies in [0, 1]",
+    );
     let both = ["track", frames, "--vocab", vocab, "-o", "out", "--height", "1.7", "--no-calibrate"];
     refused(dir, &both, 2, "cannot be used with");
     refused(dir, &["track", frames, "--vocab", "missing.vocab", "-o", "out"], 1, "missing.vocab");

@@ -78,7 +78,7 @@ impl Clustering {
 
 #[derive(Debug, thiserror::Error)]
 pub enum ClusterError {
-    #[error("--k {k} asks for more primitives than the {segments} segments there are")]
+    #[error("k = {k} asks for more primitives than the {segments} segments there are")]
     TooManyClusters { k: usize, segments: usize },
     #[error("only {0} segments: choosing the number of primitives needs at least 3")]
     TooFewSegments(usize),
@@ -283,6 +283,7 @@ fn by_first_appearance(assignments: &[usize]) -> Vec<usize> {
 mod tests {
     use super::super::hyperparams::ClusterParams;
     use super::*;
+    use crate::params::Params;
 
     /// Three tight blobs in 2-D, interleaved in segment order.
     fn blobs() -> Embedding {
@@ -312,7 +313,7 @@ mod tests {
         let c = params.cluster(&blobs(), &[]).unwrap();
         assert_eq!((c.k(), c.choice()), (2, &Choice::Given));
         let err = ClusterParams::new().k(Some(61)).check().unwrap().cluster(&blobs(), &[]).unwrap_err();
-        assert_eq!(err.to_string(), "--k 61 asks for more primitives than the 60 segments there are");
+        assert_eq!(err.to_string(), "k = 61 asks for more primitives than the 60 segments there are");
     }
 
     #[test]

@@ -1,5 +1,7 @@
 //! Clustering settings, checked once.
 
+use crate::params::{InvalidField, Params};
+
 /// Clustering settings; [`ClusterParams::check`] validates them.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ClusterParams {
@@ -64,16 +66,27 @@ pub struct ValidClusterParams(pub(crate) ClusterParams);
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum ClusterParamsError {
-    #[error("--k must be at least 1")]
+    #[error("k: the number of clusters must be at least 1")]
     K,
-    #[error("the largest number of primitives to try must be at least 2, not {0}")]
+    #[error("max_k: the largest number of primitives to try must be at least 2, not {0}")]
     MaxK(usize),
-    #[error("k-means needs at least one run")]
+    #[error("runs: k-means needs at least one run")]
     Runs,
-    #[error("the silhouette tolerance must be a non-negative number of standard errors, not {0}")]
+    #[error("tolerance: the silhouette tolerance must be a non-negative number of standard errors, not {0}")]
     Tolerance(f64),
-    #[error("a number of clusters cannot be given when clustering by label (one cluster per activity)")]
+    #[error("k: a number of clusters cannot be given when clustering by label (one cluster per activity)")]
     KByLabel,
+}
+
+impl InvalidField for ClusterParamsError {
+    fn field(&self) -> &'static str {
+        match self {
+            ClusterParamsError::K | ClusterParamsError::KByLabel => "k",
+            ClusterParamsError::MaxK(_) => "max_k",
+            ClusterParamsError::Runs => "runs",
+            ClusterParamsError::Tolerance(_) => "tolerance",
+        }
+    }
 }
 
 impl ClusterParams {
@@ -115,9 +128,13 @@ impl ClusterParams {
         self.by_label = by_label;
         self
     }
+}
 
-    /// Validates the settings; every rule has its own error.
-    pub fn check(&self) -> Result<ValidClusterParams, ClusterParamsError> {
+impl Params for ClusterParams {
+    type Valid = ValidClusterParams;
+    type Error = ClusterParamsError;
+
+    fn check(&self) -> Result<ValidClusterParams, ClusterParamsError> {
         if self.k == Some(0) {
             return Err(ClusterParamsError::K);
         }

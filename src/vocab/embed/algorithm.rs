@@ -63,7 +63,7 @@ impl Embedding {
 pub enum EmbedError {
     #[error("only {0} segments: an embedding needs at least 3")]
     TooFewSegments(usize),
-    #[error("{segments} segments can be embedded in at most {} dimensions, not the {dims} asked (--dims)", .segments - 1)]
+    #[error("{segments} segments can be embedded in at most {} dimensions, not the {dims} asked (dims)", .segments - 1)]
     TooManyDims { dims: usize, segments: usize },
     #[error("every segment is the same motion: there is nothing to tell apart")]
     AllIdentical,
@@ -341,6 +341,7 @@ fn geodesic_gram(graph: &Graph) -> Mat<f64> {
 mod tests {
     use super::super::hyperparams::EmbedParams;
     use super::*;
+    use crate::params::Params;
 
     /// Points along a spiral arm in 3-D, lifted into 6-D.
     fn spiral(n: usize) -> Vec<Vec<f64>> {

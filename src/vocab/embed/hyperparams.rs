@@ -1,5 +1,6 @@
 //! ST-Isomap settings, checked once.
 
+use crate::params::{InvalidField, Params};
 use crate::vocab::eigen::EigenMethod;
 
 /// ST-Isomap settings; [`EmbedParams::check`] validates them.
@@ -41,16 +42,28 @@ pub struct ValidEmbedParams(pub(crate) EmbedParams);
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum EmbedParamsError {
-    #[error("the number of neighbours must be at least 1")]
+    #[error("neighbors: the number of neighbours must be at least 1")]
     Neighbors,
-    #[error("the number of embedding dimensions must be at least 1")]
+    #[error("dims: the number of embedding dimensions must be at least 1")]
     Dims,
-    #[error("segments must be resampled to at least 2 frames, not {0}")]
+    #[error("resample: segments must be resampled to at least 2 frames, not {0}")]
     Resample(usize),
-    #[error("--c-atn must be a number of at least 1 (1 leaves distances as they are), not {0}")]
+    #[error("c_atn: must be a number of at least 1 (1 leaves distances as they are), not {0}")]
     Atn(f64),
-    #[error("--c-ctn must be a number of at least 1 (1 leaves distances as they are), not {0}")]
+    #[error("c_ctn: must be a number of at least 1 (1 leaves distances as they are), not {0}")]
     Ctn(f64),
+}
+
+impl InvalidField for EmbedParamsError {
+    fn field(&self) -> &'static str {
+        match self {
+            EmbedParamsError::Neighbors => "neighbors",
+            EmbedParamsError::Dims => "dims",
+            EmbedParamsError::Resample(_) => "resample",
+            EmbedParamsError::Atn(_) => "c_atn",
+            EmbedParamsError::Ctn(_) => "c_ctn",
+        }
+    }
 }
 
 impl EmbedParams {
@@ -93,9 +106,13 @@ impl EmbedParams {
         self.eigen = method;
         self
     }
+}
 
-    /// Validates the settings; every rule has its own error.
-    pub fn check(&self) -> Result<ValidEmbedParams, EmbedParamsError> {
+impl Params for EmbedParams {
+    type Valid = ValidEmbedParams;
+    type Error = EmbedParamsError;
+
+    fn check(&self) -> Result<ValidEmbedParams, EmbedParamsError> {
         let p = self;
         if p.neighbors == 0 {
             return Err(EmbedParamsError::Neighbors);

@@ -148,6 +148,7 @@ mod tests {
     use super::super::hyperparams::FitParams;
     use super::*;
     use crate::mocap::synth::{Activity, SynthOptions, activity_take};
+    use crate::params::Params;
 
     fn segments_of(motion: &Motion) -> Vec<TrainingSegment<'_>> {
         // Whole repetitions are not needed here: fixed windows will do.

@@ -1,5 +1,6 @@
 //! Primitive fitting settings, checked once.
 
+use crate::params::{InvalidField, Params};
 use crate::vocab::knn::MAX_LATENT_DIMS;
 
 /// Fitting settings; [`FitParams::check`] validates them.
@@ -29,14 +30,25 @@ pub struct ValidFitParams(pub(crate) FitParams);
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum FitParamsError {
-    #[error("--variance must lie in (0, 1], not {0}")]
+    #[error("variance: the share of pose variance kept must lie in (0, 1], not {0}")]
     Variance(f64),
-    #[error("--min-dims must be at least 1")]
+    #[error("min_dims: the fewest latent dimensions must be at least 1")]
     MinDims,
-    #[error("--max-dims must be between --min-dims ({min}) and {MAX_LATENT_DIMS}, not {max}")]
+    #[error("max_dims: the most latent dimensions must be between the fewest ({min}) and {MAX_LATENT_DIMS}, not {max}")]
     MaxDims { min: usize, max: usize },
-    #[error("the field needs at least one neighbour")]
+    #[error("neighbors: the field needs at least one neighbour")]
     Neighbors,
+}
+
+impl InvalidField for FitParamsError {
+    fn field(&self) -> &'static str {
+        match self {
+            FitParamsError::Variance(_) => "variance",
+            FitParamsError::MinDims => "min_dims",
+            FitParamsError::MaxDims { .. } => "max_dims",
+            FitParamsError::Neighbors => "neighbors",
+        }
+    }
 }
 
 impl FitParams {
@@ -63,9 +75,13 @@ impl FitParams {
         self.neighbors = k;
         self
     }
+}
 
-    /// Validates the settings; every rule has its own error.
-    pub fn check(&self) -> Result<ValidFitParams, FitParamsError> {
+impl Params for FitParams {
+    type Valid = ValidFitParams;
+    type Error = FitParamsError;
+
+    fn check(&self) -> Result<ValidFitParams, FitParamsError> {
         if !(self.variance > 0.0 && self.variance <= 1.0) {
             return Err(FitParamsError::Variance(self.variance));
         }

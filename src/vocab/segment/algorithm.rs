@@ -309,6 +309,7 @@ mod tests {
     use super::super::hyperparams::SegmentParams;
     use super::*;
     use crate::mocap::synth::{Activity, SynthOptions, activity_take};
+    use crate::params::Params;
 
     fn check_partition(cuts: &[Cut], n: usize) -> Vec<Span> {
         let spans: Vec<Span> = cuts.iter().map(|c| c.span).collect();

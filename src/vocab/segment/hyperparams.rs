@@ -1,5 +1,7 @@
 //! Segmentation settings, checked once.
 
+use crate::params::{InvalidField, Params};
+
 /// How to find segment boundaries.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -54,20 +56,34 @@ pub struct ValidSegmentParams(pub(crate) SegmentParams);
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum SegmentParamsError {
-    #[error("the minimum segment length must be a positive number of seconds, not {0}")]
+    #[error("min_length_s: the shortest segment must be a positive number of seconds, not {0}")]
     MinLength(f64),
-    #[error("the maximum segment length ({max} s) must be at least twice the minimum ({min} s)")]
+    #[error("max_length_s: the longest segment ({max} s) must be at least twice the shortest ({min} s)")]
     MaxLength { min: f64, max: f64 },
-    #[error("the smoothing must be a non-negative number of seconds, not {0}")]
+    #[error("smoothing_s: the smoothing must be a non-negative number of seconds, not {0}")]
     Smoothing(f64),
-    #[error("the return share must lie in (0, 1), not {0}")]
+    #[error("return_share: the return share must lie in (0, 1), not {0}")]
     ReturnShare(f64),
-    #[error("the retrace share must lie in (0, 1), not {0}")]
+    #[error("retrace_share: the retrace share must lie in (0, 1), not {0}")]
     RetraceShare(f64),
-    #[error("the smallest swing must be a non-negative number of meters, not {0}")]
+    #[error("min_excursion_m: the smallest swing must be a non-negative number of meters, not {0}")]
     MinExcursion(f64),
-    #[error("the dip share must lie in (0, 1), not {0}")]
+    #[error("dip_share: the dip share must lie in (0, 1), not {0}")]
     DipShare(f64),
+}
+
+impl InvalidField for SegmentParamsError {
+    fn field(&self) -> &'static str {
+        match self {
+            SegmentParamsError::MinLength(_) => "min_length_s",
+            SegmentParamsError::MaxLength { .. } => "max_length_s",
+            SegmentParamsError::Smoothing(_) => "smoothing_s",
+            SegmentParamsError::ReturnShare(_) => "return_share",
+            SegmentParamsError::RetraceShare(_) => "retrace_share",
+            SegmentParamsError::MinExcursion(_) => "min_excursion_m",
+            SegmentParamsError::DipShare(_) => "dip_share",
+        }
+    }
 }
 
 impl SegmentParams {
@@ -114,9 +130,13 @@ impl SegmentParams {
         self.dip_share = share;
         self
     }
+}
 
-    /// Validates the settings; every rule has its own error.
-    pub fn check(&self) -> Result<ValidSegmentParams, SegmentParamsError> {
+impl Params for SegmentParams {
+    type Valid = ValidSegmentParams;
+    type Error = SegmentParamsError;
+
+    fn check(&self) -> Result<ValidSegmentParams, SegmentParamsError> {
         let p = self;
         let unit = |x: f64| x > 0.0 && x < 1.0;
         if !(p.min_length_s > 0.0 && p.min_length_s.is_finite()) {
