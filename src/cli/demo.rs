@@ -1,8 +1,10 @@
 //! `imitate demo`: the main job on what ships with the program.
 
 use super::eval::SEQUENCE;
-use super::{Global, Outcome, arg, invoke, note, progress};
+use super::{Global, Outcome, UsageError, arg, invoke, note, progress};
 use anyhow::{Context, bail};
+use imitate::params::{InvalidField, Params};
+use imitate::track::clip::{ClipOptions, track_clip};
 use std::path::PathBuf;
 
 /// The shipped vocabulary (vocab/default.vocab), built into the program so
@@ -37,6 +39,8 @@ pub struct Args {
 }
 
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
+    let options = ClipOptions { particles: args.particles, seed: args.seed, feedback: true, ..ClipOptions::default() };
+    options.check().map_err(|e| UsageError(e.naming(&format!("--particles {}", args.particles))))?;
     let dir = &args.output;
     if dir.read_dir().is_ok_and(|mut d| d.next().is_some()) {
         if !dir.join(MARKER).is_file() {
@@ -45,7 +49,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         std::fs::remove_dir_all(dir).with_context(|| format!("{}: cannot replace the previous demo", dir.display()))?;
     }
     std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
-    let result = demo(&args, global);
+    let result = demo(&args, &options, global);
     if result.is_err() {
         // No half-made demo is left behind.
         let _ = std::fs::remove_dir_all(dir);
@@ -53,7 +57,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     result
 }
 
-fn demo(args: &Args, global: Global) -> anyhow::Result<Outcome> {
+fn demo(args: &Args, options: &ClipOptions, global: Global) -> anyhow::Result<Outcome> {
     let started = std::time::Instant::now();
     let dir = &args.output;
     let bar = progress(global, 5, "demo");
@@ -67,7 +71,6 @@ fn demo(args: &Args, global: Global) -> anyhow::Result<Outcome> {
     std::fs::write(&vocab, SHIPPED_VOCAB).with_context(|| format!("{}: cannot write", vocab.display()))?;
     let (motion, video, run, report) = (dir.join("motion"), dir.join("video"), dir.join("run"), dir.join("report"));
     let humanoid = dir.join("humanoid");
-    let seed = args.seed.to_string();
 
     step("synth: hand circles, horizontal waving, vertical waving");
     invoke(&[
@@ -93,20 +96,7 @@ fn demo(args: &Args, global: Global) -> anyhow::Result<Outcome> {
     ])?;
     bar.inc(1);
     step("track: the shipped vocabulary, eq. 10");
-    let particles = args.particles.to_string();
-    invoke(&[
-        "track",
-        &arg(&video.join("frames")),
-        "--vocab",
-        &arg(&vocab),
-        "-o",
-        &arg(&run),
-        "--particles",
-        &particles,
-        "--seed",
-        &seed,
-        "--feedback",
-    ])?;
+    track_clip(&video.join("frames"), &vocab, options, &mut |_| {})?.write(&run, false)?;
     bar.inc(1);
     step("execute: the virtual trajectory on the humanoid");
     invoke(&["execute", &arg(&run.join("trajectory.bvh")), "-o", &arg(&humanoid)])?;

@@ -14,6 +14,7 @@ use imitate::report::filmstrip::{filmstrip, pick_frames};
 use imitate::report::metrics::{SETTLE_S, Track, score};
 use imitate::report::read_track;
 use imitate::report::run::Run;
+use imitate::track::clip::{Baseline, CameraChoice, ClipOptions, track_clip_with};
 use imitate::track::filter::FilterParams;
 use imitate::vision::camera::Camera;
 use imitate::vocab::vocabulary::Vocabulary;
@@ -21,6 +22,7 @@ use indicatif::ProgressBar;
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Run the paper's trials end to end and write an evaluation report:
 /// builds a vocabulary of the four paper activities from synthetic takes
@@ -103,6 +105,8 @@ impl Plan {
 struct Work {
     dir: PathBuf,
     vocab: PathBuf,
+    /// Vocabularies once read, by path.
+    read: RefCell<HashMap<PathBuf, Arc<Vocabulary>>>,
     /// The tracker seeds every setting runs.
     seeds: Vec<u64>,
     bar: ProgressBar,
@@ -120,11 +124,73 @@ struct Label<'a> {
 }
 
 /// One way of tracking that a trial compares: its series, what it sets,
-/// and its `track` options.
+/// and how it tracks (the particle count is the trial's).
 struct Variant<'a> {
     series: &'a str,
     params: serde_json::Value,
-    options: &'a [&'a str],
+    how: How,
+}
+
+/// How a setting tracks: the clip options the trials vary, the others at
+/// `imitate track`'s defaults.
+#[derive(Clone, Copy, Debug)]
+struct How {
+    particles: usize,
+    lookahead: usize,
+    /// Eq. 10 rather than eq. 7.
+    feedback: bool,
+    calibrate: bool,
+    /// The camera estimated from the frames, not the one rendered beside them.
+    estimate_camera: bool,
+    /// The full-space annealed filter instead of the primitives'.
+    full_space: bool,
+}
+
+impl How {
+    /// Eq. 10 with `particles` per primitive, the rest as `track`'s defaults.
+    fn eq10(particles: usize) -> How {
+        let defaults = ClipOptions::default();
+        How {
+            particles,
+            lookahead: defaults.lookahead,
+            feedback: true,
+            calibrate: true,
+            estimate_camera: false,
+            full_space: false,
+        }
+    }
+
+    /// Eq. 10 with everything else as `track`'s defaults.
+    fn standard() -> How {
+        How::eq10(ClipOptions::default().particles)
+    }
+
+    /// The folder-name part that tells this setting from the others.
+    fn name(&self) -> String {
+        let mut name =
+            format!("p{}_k{}_{}", self.particles, self.lookahead, if self.feedback { "eq10" } else { "eq7" });
+        for (on, what) in
+            [(!self.calibrate, "canonical"), (self.estimate_camera, "auto-camera"), (self.full_space, "full-space")]
+        {
+            if on {
+                name += &format!("_{what}");
+            }
+        }
+        name
+    }
+
+    fn options(&self, seed: u64) -> ClipOptions {
+        ClipOptions {
+            particles: self.particles,
+            lookahead: self.lookahead,
+            seed,
+            feedback: self.feedback,
+            calibrate: self.calibrate,
+            camera: if self.estimate_camera { CameraChoice::Auto } else { CameraChoice::Beside },
+            baseline: self.full_space.then_some(Baseline::FullSpace),
+            ..ClipOptions::default()
+        }
+    }
 }
 
 /// A rendered video: its name, frames and truth.
@@ -141,6 +207,7 @@ impl Work {
     fn with_vocab(&self, vocab: PathBuf) -> Work {
         Work {
             vocab,
+            read: RefCell::default(),
             seeds: self.seeds.clone(),
             bar: self.bar.clone(),
             dir: self.dir.clone(),
@@ -204,29 +271,22 @@ impl Work {
         self.render(name, &bvh, &dir.join("labels.csv"), camera)
     }
 
-    /// The folder of the run of `video` with `options` and `seed`.
-    fn run_dir(&self, video: &Video, options: &[&str], seed: u64) -> PathBuf {
-        let name: String = std::iter::once(video.name.as_str())
-            .chain(options.iter().copied())
-            .collect::<Vec<_>>()
-            .join("_")
-            .chars()
-            .map(|c| if c.is_ascii_alphanumeric() || c == '.' { c } else { '-' })
-            .collect();
-        self.path(&format!("runs/{name}_seed{seed}"))
+    /// The folder of the run of `video` tracked `how` with `seed`.
+    fn run_dir(&self, video: &Video, how: How, seed: u64) -> PathBuf {
+        self.path(&format!("runs/{}_{}_seed{seed}", video.name, how.name()))
     }
 
-    /// Tracks `video` with `options` and `seed`, and scores it (once).
-    fn track(&self, video: &Video, options: &[&str], seed: u64) -> anyhow::Result<RunScore> {
-        let out = self.run_dir(video, options, seed);
+    /// Tracks `video` `how` with `seed`, and scores it (once).
+    fn track(&self, video: &Video, how: How, seed: u64) -> anyhow::Result<RunScore> {
+        let out = self.run_dir(video, how, seed);
         let key = arg(&out);
         if let Some(done) = self.done.borrow().get(&key) {
             return Ok(done.clone());
         }
-        self.step(&format!("track {video} {options}", video = video.name, options = options.join(" ")));
-        let seed = seed.to_string();
-        let args = ["track", &arg(&video.frames), "--vocab", &arg(&self.vocab), "-o", &key, "--seed", &seed, "--force"];
-        invoke(&[&args[..], options].concat())?;
+        self.step(&format!("track {} {}", video.name, how.name()));
+        let vocabulary = self.vocabulary()?;
+        let tracked = track_clip_with(&video.frames, &self.vocab, vocabulary, &how.options(seed), &mut |_| {})?;
+        tracked.write(&out, true)?;
         let run = Run::read(&out)?;
         let truth = read_track(&video.truth)?;
         let metrics = score(&run.track, &truth, &run.primitives, SETTLE_S)?;
@@ -243,9 +303,25 @@ impl Work {
         Ok(scored)
     }
 
+    /// The vocabulary at `vocab`, read once.
+    fn vocabulary(&self) -> anyhow::Result<Arc<Vocabulary>> {
+        self.vocabulary_at(&self.vocab)
+    }
+
+    /// The vocabulary at `path`, read once: the trials' own or another
+    /// trial's kept alongside.
+    fn vocabulary_at(&self, path: &Path) -> anyhow::Result<Arc<Vocabulary>> {
+        if let Some(read) = self.read.borrow().get(path) {
+            return Ok(read.clone());
+        }
+        let read = Arc::new(Vocabulary::load(path)?);
+        self.read.borrow_mut().insert(path.to_path_buf(), read.clone());
+        Ok(read)
+    }
+
     /// One setting over every seed.
-    fn setting(&self, video: &Video, label: Label, options: &[&str]) -> anyhow::Result<Setting> {
-        let runs = self.seeds.iter().map(|&seed| self.track(video, options, seed)).collect::<anyhow::Result<_>>()?;
+    fn setting(&self, video: &Video, label: Label, how: How) -> anyhow::Result<Setting> {
+        let runs = self.seeds.iter().map(|&seed| self.track(video, how, seed)).collect::<anyhow::Result<_>>()?;
         let params = label.params.as_object().cloned().unwrap_or_default();
         Ok(Setting { series: label.series.into(), x: label.x, params, runs })
     }
@@ -255,12 +331,11 @@ impl Work {
     fn per_particles(&self, video: &Video, counts: &[usize], variants: &[Variant]) -> anyhow::Result<Vec<Setting>> {
         let mut settings = Vec::new();
         for &n in counts {
-            let p = n.to_string();
             for v in variants {
                 let mut params = v.params.clone();
                 params["particles"] = n.into();
-                let options = [&["--particles", p.as_str()][..], v.options].concat();
-                settings.push(self.setting(video, Label { series: v.series, x: p.clone(), params }, &options)?);
+                let how = How { particles: n, ..v.how };
+                settings.push(self.setting(video, Label { series: v.series, x: n.to_string(), params }, how)?);
             }
         }
         Ok(settings)
@@ -364,7 +439,14 @@ fn evaluate(args: &Args, global: Global, dir: &Path) -> anyhow::Result<Outcome> 
     let plan = Plan::new(args.quick, args.seed);
     let bar = super::progress(global, 0, "eval");
     let done = RefCell::new(HashMap::new());
-    let mut work = Work { dir: dir.to_path_buf(), vocab: PathBuf::new(), seeds: plan.seeds.clone(), bar, done };
+    let mut work = Work {
+        dir: dir.to_path_buf(),
+        vocab: PathBuf::new(),
+        read: RefCell::default(),
+        seeds: plan.seeds.clone(),
+        bar,
+        done,
+    };
     work.vocab = match &args.vocab {
         Some(v) => v.clone(),
         None => paper_vocabulary(&work, args.seed)?,
@@ -383,7 +465,7 @@ fn evaluate(args: &Args, global: Global, dir: &Path) -> anyhow::Result<Outcome> 
         + 6 * plan.bodies.len();
     work.bar.set_length((settings * plan.seeds.len()) as u64);
     let front = work.synth("front", SEQUENCE, 3, held_out, 1.0, "front")?;
-    let first = work.run_dir(&front, &["--particles", &plan.particles[0].to_string(), "--feedback"], plan.seeds[0]);
+    let first = work.run_dir(&front, How::eq10(plan.particles[0]), plan.seeds[0]);
     let mut trials = vec![
         trial_one(&work, &plan, &front, &first)?,
         recognition(&work, &plan, &front, &first)?,
@@ -461,7 +543,7 @@ fn paper_vocabulary(work: &Work, seed: u64) -> anyhow::Result<PathBuf> {
 
 /// Trial one: error against particles per primitive.
 fn trial_one(work: &Work, plan: &Plan, front: &Video, first: &Path) -> anyhow::Result<Trial> {
-    let eq10 = Variant { series: "eq. 10", params: serde_json::json!({}), options: &["--feedback"] };
+    let eq10 = Variant { series: "eq. 10", params: serde_json::json!({}), how: How::eq10(0) };
     Ok(Trial {
         key: "particles".into(),
         title: "Trial one: particles per primitive".into(),
@@ -486,8 +568,12 @@ fn trial_one(work: &Work, plan: &Plan, front: &Video, first: &Path) -> anyhow::R
 /// Recognition: eq. 7 against eq. 10, and Figure 8.
 fn recognition(work: &Work, plan: &Plan, front: &Video, first: &Path) -> anyhow::Result<Trial> {
     let variants = [
-        Variant { series: "eq. 7", params: serde_json::json!({"recognition": "eq7"}), options: &[] },
-        Variant { series: "eq. 10", params: serde_json::json!({"recognition": "eq10"}), options: &["--feedback"] },
+        Variant {
+            series: "eq. 7",
+            params: serde_json::json!({"recognition": "eq7"}),
+            how: How { feedback: false, ..How::eq10(0) },
+        },
+        Variant { series: "eq. 10", params: serde_json::json!({"recognition": "eq10"}), how: How::eq10(0) },
     ];
     Ok(Trial {
         key: "recognition".into(),
@@ -505,11 +591,11 @@ fn recognition(work: &Work, plan: &Plan, front: &Video, first: &Path) -> anyhow:
 /// The bending cone (K = 5) and the straight line (K = 1) on `video`.
 fn cone_and_line(work: &Work, video: &Video, x: &str, params: serde_json::Value) -> anyhow::Result<Vec<Setting>> {
     let mut settings = Vec::new();
-    for (k, series) in [("5", "bending cone, K = 5"), ("1", "straight line, K = 1")] {
+    for (k, series) in [(5, "bending cone, K = 5"), (1, "straight line, K = 1")] {
         let mut params = params.clone();
-        params["lookahead"] = k.parse::<u64>().expect("a number").into();
+        params["lookahead"] = k.into();
         let label = Label { series, x: x.to_string(), params };
-        settings.push(work.setting(video, label, &["--lookahead", k, "--feedback"])?);
+        settings.push(work.setting(video, label, How { lookahead: k, ..How::standard() })?);
     }
     Ok(settings)
 }
@@ -532,7 +618,7 @@ fn speed(work: &Work, plan: &Plan, held_out: u64) -> anyhow::Result<Trial> {
     let params = serde_json::json!({"speed": 4.0, "hand_m_per_s": hand, "hand_p95_m_per_s": peak, "activity": "punch"});
     settings.extend(cone_and_line(work, &punch, &format!("punch 4× ({hand:.2}, {peak:.2} m/s)"), params)?);
     let (fast, top) = fastest.expect("the plan has speeds");
-    let cone = ["--lookahead", "5", "--feedback"];
+    let cone = How { lookahead: 5, ..How::standard() };
     Ok(Trial {
         key: "speed".into(),
         title: "Trial two: speed".into(),
@@ -545,13 +631,13 @@ fn speed(work: &Work, plan: &Plan, held_out: u64) -> anyhow::Result<Trial> {
         settings,
         pictures: vec![
             strip(
-                &work.run_dir(&fast, &cone, work.seeds[0]),
+                &work.run_dir(&fast, cone, work.seeds[0]),
                 &fast,
                 "filmstrip-fast",
                 &format!("Trial two at {top}× (as Figure 6)."),
             )?,
             strip(
-                &work.run_dir(&punch, &cone, work.seeds[0]),
+                &work.run_dir(&punch, cone, work.seeds[0]),
                 &punch,
                 "filmstrip-punch",
                 "The fast punch (as Figure 5).",
@@ -569,11 +655,10 @@ fn viewpoint(work: &Work, front: &Video, held_out: u64) -> anyhow::Result<Trial>
             "front" => front.clone(),
             _ => work.synth(camera, SEQUENCE, 3, held_out, 1.0, camera)?,
         };
-        for n in ["6", "25"] {
-            let params = serde_json::json!({"camera": camera, "particles": n.parse::<u64>().expect("a number")});
-            let label =
-                Label { series: if n == "6" { "6 particles" } else { "25 particles" }, x: camera.into(), params };
-            settings.push(work.setting(&video, label, &["--particles", n, "--feedback"])?);
+        for (n, series) in [(6, "6 particles"), (25, "25 particles")] {
+            let params = serde_json::json!({"camera": camera, "particles": n});
+            let label = Label { series, x: camera.into(), params };
+            settings.push(work.setting(&video, label, How::eq10(n))?);
         }
         overhead = Some(video);
     }
@@ -588,7 +673,7 @@ fn viewpoint(work: &Work, front: &Video, held_out: u64) -> anyhow::Result<Trial>
         charts: vec![Measure::UpperBody, Measure::Recognition],
         settings,
         pictures: vec![strip(
-            &work.run_dir(&overhead, &["--particles", "6", "--feedback"], work.seeds[0]),
+            &work.run_dir(&overhead, How::eq10(6), work.seeds[0]),
             &overhead,
             "filmstrip-overhead",
             "Overhead camera (as Figure 7).",
@@ -603,12 +688,12 @@ fn baseline(work: &Work, plan: &Plan, front: &Video) -> anyhow::Result<Trial> {
             series: "primitives",
             params: serde_json::json!({"follower": "primitives"}),
             // Both draw the canonical body, so the budgets are the followers' alone.
-            options: &["--feedback", "--no-calibrate"],
+            how: How { calibrate: false, ..How::eq10(0) },
         },
         Variant {
             series: "full-space annealed filter",
             params: serde_json::json!({"follower": "full_space"}),
-            options: &["--baseline", "full-space"],
+            how: How { feedback: false, full_space: true, ..How::eq10(0) },
         },
     ];
     Ok(Trial {
@@ -673,7 +758,7 @@ fn real_trial(work: &Work, real: &Path) -> anyhow::Result<Option<Trial>> {
             video = real_work.render(&format!("real-{name}"), &bvh, &real_labels, &arg(&behind))?;
         }
         let label = Label { series: "eq. 10", x: name.into(), params: serde_json::json!({"take": take}) };
-        settings.push(real_work.setting(&video, label, &["--feedback"])?);
+        settings.push(real_work.setting(&video, label, How::standard())?);
     }
     work.absorb(real_work);
     Ok(Some(Trial {

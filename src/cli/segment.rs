@@ -61,8 +61,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let (takes, settings) = (&args.takes, args.takes.retarget.settings());
     let corpus = load_corpus(&takes.inputs, takes.labels.as_deref(), &takes.retarget.options()?, global)?;
     let lineage = Lineage::new(settings, params.params().clone());
-    let segments =
-        segment(&corpus, &params, lineage, &mut Notes(global)).with_context(|| takes_named(&corpus))?;
+    let segments = segment(&corpus, &params, lineage, &mut Notes(global)).with_context(|| takes_named(&corpus))?;
     segments.write(&args.output)?;
     note(global, &format!("wrote {}", args.output.display()));
     Ok(Outcome::Success)

@@ -230,12 +230,7 @@ pub fn cluster(
         listener.note(&format!(
             "against the labels: purity {:.3}, adjusted Rand index {:.3} over the {} segments of one activity; \
              {:.3} and {:.3} over all {}",
-            whole.purity,
-            whole.adjusted_rand_index,
-            whole.segments,
-            all.purity,
-            all.adjusted_rand_index,
-            all.segments
+            whole.purity, whole.adjusted_rand_index, whole.segments, all.purity, all.adjusted_rand_index, all.segments
         ));
         let missing = activities_without_primitive(rows, clustering.assignments());
         if !missing.is_empty() {

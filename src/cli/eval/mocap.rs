@@ -2,7 +2,7 @@
 //! measures ([`imitate::report::corpora`]), and a tracking trial on a
 //! performance style the vocabulary never saw.
 
-use super::{Label, Work};
+use super::{How, Label, Work};
 use crate::cli::{arg, invoke};
 use imitate::report::corpora::{
     TrackedTake, TrackingSelection, corpora_table, corpus_folders, held_out_table, load_corpora, tracking_selection,
@@ -56,7 +56,6 @@ fn held_out_tracking(work: &Work, selection: &TrackingSelection) -> anyhow::Resu
     let styles_work = work.with_vocab(vocab);
     let mut settings = Vec::new();
     let (mut rows, mut metrics) = (Vec::new(), Vec::new());
-    let particles = PARTICLES.to_string();
     for TrackedTake { activity, path: take, motion } in &selection.tracked {
         let projected = latent_projection_mm(vocabulary.primitives(), motion).unwrap_or(f64::NAN);
         let file = take.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
@@ -66,7 +65,7 @@ fn held_out_tracking(work: &Work, selection: &TrackingSelection) -> anyhow::Resu
             let video = styles_work.render(&format!("mocap-{camera}-{activity}"), take, &selection.labels, camera)?;
             let params = json!({"camera": camera, "activity": activity, "take": file, "particles": PARTICLES});
             let label = Label { series: camera, x: activity.clone(), params };
-            settings.push(styles_work.setting(&video, label, &["--particles", &particles, "--feedback"])?);
+            settings.push(styles_work.setting(&video, label, How::eq10(PARTICLES))?);
         }
     }
     work.absorb(styles_work);

@@ -3,7 +3,7 @@
 //! the front preset and by a raised camera, tracked with and without body
 //! calibration, and through a camera estimated from the frames.
 
-use super::{Label, Plan, Video, Work};
+use super::{How, Label, Plan, Video, Work};
 use imitate::report::eval::{Measure, Trial};
 use imitate::vision::camera::{CameraSpec, Preset};
 
@@ -29,27 +29,26 @@ pub(super) fn trial(work: &Work, plan: &Plan, front: &Video) -> anyhow::Result<T
     let json = serde_json::to_string_pretty(&raised_camera()).expect("a camera serializes");
     std::fs::write(&raised, json).map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", raised.display()))?;
     let raised = super::arg(&raised);
-    let particles = plan.person_particles.to_string();
     let mut settings = Vec::new();
     let mut shown = None;
     for body in &plan.bodies {
         for (camera_name, camera) in [("front", "front"), ("raised", raised.as_str())] {
             let name = format!("person-{body}-{camera_name}");
             let video = work.render_with(&name, &bvh, &labels, &["--camera", camera, "--body", body])?;
-            let series: [(&str, &[&str]); 3] = [
-                ("calibrated", &[]),
-                ("not calibrated", &["--no-calibrate"]),
-                ("calibrated, camera estimated", &["--camera", "auto"]),
+            let told = How::eq10(plan.person_particles);
+            let series = [
+                ("calibrated", told),
+                ("not calibrated", How { calibrate: false, ..told }),
+                ("calibrated, camera estimated", How { estimate_camera: true, ..told }),
             ];
-            for (series, options) in series {
+            for (series, how) in series {
                 let params = serde_json::json!({
                     "body": body, "camera": camera_name, "particles": plan.person_particles,
-                    "calibrated": !options.contains(&"--no-calibrate"),
-                    "camera_estimated": options.contains(&"auto"),
+                    "calibrated": how.calibrate,
+                    "camera_estimated": how.estimate_camera,
                 });
                 let label = Label { series, x: format!("{body}, {camera_name}"), params };
-                let options = [&["--particles", particles.as_str(), "--feedback"][..], options].concat();
-                settings.push(work.setting(&video, label, &options)?);
+                settings.push(work.setting(&video, label, how)?);
             }
             if *body == plan.bodies[plan.bodies.len() - 1] && camera_name == "raised" {
                 shown = Some(video);
@@ -57,7 +56,7 @@ pub(super) fn trial(work: &Work, plan: &Plan, front: &Video) -> anyhow::Result<T
         }
     }
     let shown = shown.expect("the last body is filmed by the raised camera");
-    let picture_run = work.run_dir(&shown, &["--particles", &particles, "--feedback"], work.seeds[0]);
+    let picture_run = work.run_dir(&shown, How::eq10(plan.person_particles), work.seeds[0]);
     Ok(Trial {
         key: "person".into(),
         title: "The person is not the model".into(),

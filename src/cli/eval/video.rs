@@ -6,6 +6,7 @@
 //! (PCK@0.2) observing the silhouette, the keypoints or both, the activity
 //! each run credits, and its speed.
 
+use super::How;
 use super::Work;
 use crate::cli::score::{keypoint_agreement, silhouette_agreement};
 use crate::cli::{arg, invoke};
@@ -13,6 +14,7 @@ use anyhow::Context;
 use imitate::report::eval::{Table, TimingRow};
 use imitate::report::metrics::SETTLE_S;
 use imitate::report::run::Run;
+use imitate::track::clip::{ClipOptions, Observe, track_clip_with};
 use imitate::vision::resize::DEFAULT_WORK_WIDTH;
 use imitate::vocab::corpus::{Labels, read_labels};
 use serde_json::json;
@@ -107,12 +109,16 @@ pub(super) fn section(
 ) -> anyhow::Result<(Table, Vec<TimingRow>)> {
     let clips = clips(dir)?;
     let (mut rows, mut metrics, mut timing) = (Vec::new(), Vec::new(), Vec::new());
-    let particles = PARTICLES.to_string();
+    let vocabulary = work.vocabulary_at(vocab)?;
     for clip in &clips {
         let keypoints = reference.map(|r| r.join(&clip.name).join("keypoints.csv"));
         let masks = reference.map(|r| r.join(&clip.name).join("masks"));
-        let observes: &[&str] =
-            if keypoints.is_some() { &["silhouette", "keypoints", "both"] } else { &["silhouette"] };
+        let observes: &[(&str, Observe)] = match keypoints {
+            Some(_) => {
+                &[("silhouette", Observe::Silhouette), ("keypoints", Observe::Keypoints), ("both", Observe::Both)]
+            }
+            None => &[("silhouette", Observe::Silhouette)],
+        };
         let silhouettes = match &masks {
             Some(masks) => {
                 work.step(&format!("real video: {} silhouettes", clip.name));
@@ -121,19 +127,19 @@ pub(super) fn section(
             None => None,
         };
         let (mut pck, mut credited, mut failed) = (BTreeMap::new(), BTreeMap::new(), BTreeMap::new());
-        for &observe in observes {
+        for &(observe, kind) in observes {
             work.step(&format!("real video: {} ({observe})", clip.name));
             let out = work.path(&format!("runs/real-{}-{observe}", clip.name));
-            let mut args = vec!["track".to_string(), arg(&clip.file), "--vocab".into(), arg(vocab)];
-            args.extend(["-o".into(), arg(&out), "--particles".into(), particles.clone(), "--feedback".into()]);
-            args.extend(["--force".into(), "--seed".into(), work.seeds[0].to_string()]);
-            if let Some(k) = &keypoints {
-                args.extend(["--keypoints".into(), arg(k), "--observe".into(), observe.into()]);
-            }
+            let options = ClipOptions {
+                keypoints: keypoints.clone(),
+                observe: Some(kind),
+                ..How::eq10(PARTICLES).options(work.seeds[0])
+            };
+            let tracked = track_clip_with(&clip.file, vocab, vocabulary.clone(), &options, &mut |_| {});
             // A clip the tracker refuses is a row that says why, not the
             // end of the report.
-            if let Err(e) = invoke(&args) {
-                failed.insert(observe, format!("{e:#}"));
+            if let Err(e) = tracked.and_then(|t| t.write(&out, true)) {
+                failed.insert(observe, e.to_string());
                 continue;
             }
             let run = Run::read(&out)?;
@@ -153,10 +159,10 @@ pub(super) fn section(
         let share = |observe: &str| {
             credited.get(observe).map_or("n/a".to_string(), |c: &Credit| format!("{:.0}%", 100.0 * c.labelled))
         };
-        let unexplained = match observes.iter().any(|o| credited.contains_key(o)) {
+        let unexplained = match observes.iter().any(|(o, _)| credited.contains_key(o)) {
             true => observes
                 .iter()
-                .map(|o| credited.get(o).map_or("n/a".into(), |c| format!("{:.0}%", 100.0 * c.unexplained)))
+                .map(|(o, _)| credited.get(o).map_or("n/a".into(), |c| format!("{:.0}%", 100.0 * c.unexplained)))
                 .collect::<Vec<_>>()
                 .join(" / "),
             false => "n/a".into(),
