@@ -79,6 +79,28 @@ impl Site {
     pub fn index(self) -> usize {
         self as usize
     }
+
+    /// Its name in snake case (`left_shoulder`), which [`Site::named`] reads.
+    pub fn name(self) -> &'static str {
+        const NAMES: [&str; 15] = [
+            "nose",
+            "neck",
+            "left_shoulder",
+            "right_shoulder",
+            "left_elbow",
+            "right_elbow",
+            "left_wrist",
+            "right_wrist",
+            "mid_hip",
+            "left_hip",
+            "right_hip",
+            "left_knee",
+            "right_knee",
+            "left_ankle",
+            "right_ankle",
+        ];
+        NAMES[self.index()]
+    }
 }
 
 /// A layout a detector writes its points in, by their order.
@@ -509,6 +531,13 @@ mod tests {
         let path = dir.join(name);
         std::fs::write(&path, text).unwrap();
         path
+    }
+
+    #[test]
+    fn every_site_is_read_back_from_its_name() {
+        for site in Site::ALL {
+            assert_eq!(Site::named(site.name()), Some(site));
+        }
     }
 
     #[test]
