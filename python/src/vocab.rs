@@ -42,6 +42,7 @@ fn learn_failure(e: &LearnError, mapping: Option<&Path>) -> PyErr {
             CorpusError::BadLabels { path, .. } => (Class::Error, Some(path.clone())),
         },
         LearnError::Stage { .. } => (Class::Vocabulary, None),
+        LearnError::Folder(path) => (Class::Bvh, Some(path.clone())),
     };
     failure(class, e, path)
 }

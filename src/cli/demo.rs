@@ -3,8 +3,14 @@
 use super::eval::SEQUENCE;
 use super::{Global, Outcome, UsageError, arg, invoke, note, progress};
 use anyhow::{Context, bail};
+use imitate::mocap::retarget::RetargetOptions;
+use imitate::mocap::synth::{SynthOptions, files};
 use imitate::params::{InvalidField, Params};
+use imitate::sim::execute::{ExecuteParams, execute};
 use imitate::track::clip::{ClipOptions, track_clip};
+use imitate::vision::camera::{Camera, Preset};
+use imitate::vision::filming::{DEFAULT_SIZE, Filming, film};
+use imitate::vocab::learn::read_take;
 use std::path::PathBuf;
 
 /// The shipped vocabulary (vocab/default.vocab), built into the program so
@@ -73,33 +79,27 @@ fn demo(args: &Args, options: &ClipOptions, global: Global) -> anyhow::Result<Ou
     let humanoid = dir.join("humanoid");
 
     step("synth: hand circles, horizontal waving, vertical waving");
-    invoke(&[
-        "synth",
-        "-o",
-        &arg(&motion),
-        "--sequence",
-        SEQUENCE,
-        "--reps",
-        "3",
-        "--seed",
-        &(args.seed + 1000).to_string(),
-    ])?;
+    let performed = SynthOptions { repetitions: 3, seed: args.seed + 1000, ..SynthOptions::default() };
+    files::write_sequence(&motion, SEQUENCE, &performed)?;
     bar.inc(1);
     step("render: front camera, 160×120, 15 fps");
-    invoke(&[
-        "render",
-        &arg(&motion.join("sequence.bvh")),
-        "-o",
-        &arg(&video),
-        "--labels",
-        &arg(&motion.join("labels.csv")),
-    ])?;
+    // Read back from its file, as `render` would read it.
+    let labels = motion.join(files::LABELS_FILE);
+    let (take, activities) =
+        read_take(&motion.join(files::SEQUENCE_FILE), Some(&labels), &RetargetOptions::default(), &mut ())?;
+    let camera = Camera::preset(Preset::Front, DEFAULT_SIZE.0, DEFAULT_SIZE.1)?;
+    film(&take, activities.as_deref(), &Filming::new(camera), &video, &|| {})?;
     bar.inc(1);
     step("track: the shipped vocabulary, eq. 10");
     track_clip(&video.join("frames"), &vocab, options, &mut |_| {})?.write(&run, false)?;
     bar.inc(1);
     step("execute: the virtual trajectory on the humanoid");
-    invoke(&["execute", &arg(&run.join("trajectory.bvh")), "-o", &arg(&humanoid)])?;
+    let trajectory = run.join("trajectory.bvh");
+    let (played, _) = read_take(&trajectory, None, &RetargetOptions::default(), &mut ())?;
+    let execution = execute(&played, &ExecuteParams::default().check()?, || {})?;
+    execution
+        .write(&humanoid, &arg(&trajectory), 0)
+        .with_context(|| format!("{}: cannot write", humanoid.display()))?;
     bar.inc(1);
     step("score and report");
     let truth = video.join("truth.csv");

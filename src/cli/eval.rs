@@ -5,9 +5,12 @@ mod person;
 mod video;
 
 use super::report::{silhouettes, tracked_camera};
-use super::{Global, Outcome, UsageError, arg, invoke, refuse_nonempty};
+use super::{Global, Outcome, UsageError, arg, refuse_nonempty};
 use anyhow::Context;
 use imitate::fsutil::write_dir_atomic;
+use imitate::mocap::retarget::RetargetOptions;
+use imitate::mocap::synth::{Activity, SynthOptions, files};
+use imitate::params::Params;
 use imitate::report::eval::{Measure, Picture, Provenance, RunScore, Setting, Trial, eval_report};
 use imitate::report::figures;
 use imitate::report::filmstrip::{filmstrip, pick_frames};
@@ -16,7 +19,12 @@ use imitate::report::read_track;
 use imitate::report::run::Run;
 use imitate::track::clip::{Baseline, CameraChoice, ClipOptions, track_clip_with};
 use imitate::track::filter::FilterParams;
-use imitate::vision::camera::Camera;
+use imitate::vision::camera::{Camera, Preset};
+use imitate::vision::figure::Build;
+use imitate::vision::filming::{DEFAULT_SIZE, Filming, film};
+use imitate::vocab::cluster::ClusterParams;
+use imitate::vocab::learn::{self, Built, Takes, read_take};
+use imitate::vocab::pipeline::BuildParams;
 use imitate::vocab::vocabulary::Vocabulary;
 use indicatif::ProgressBar;
 use std::cell::RefCell;
@@ -228,18 +236,28 @@ impl Work {
         self.bar.set_message(what.to_string());
     }
 
-    /// Renders `bvh` (labelled by `labels`) as seen by `camera` into `name`.
-    fn render(&self, name: &str, bvh: &Path, labels: &Path, camera: &str) -> anyhow::Result<Video> {
-        self.render_with(name, bvh, labels, &["--camera", camera])
+    /// Renders `bvh` (labelled by `labels`) as seen by a `preset` camera
+    /// into `name`.
+    fn render(&self, name: &str, bvh: &Path, labels: &Path, preset: Preset) -> anyhow::Result<Video> {
+        self.film(name, bvh, labels, Camera::preset(preset, DEFAULT_SIZE.0, DEFAULT_SIZE.1)?, None)
     }
 
-    /// Renders `bvh` (labelled by `labels`) with `render` `options` into
-    /// `name`.
-    fn render_with(&self, name: &str, bvh: &Path, labels: &Path, options: &[&str]) -> anyhow::Result<Video> {
+    /// Films `bvh` (labelled by `labels`) through `camera`, performed by
+    /// `build` (`None`: the tracker's capsules), into `name`, as `render`
+    /// does by default otherwise.
+    fn film(
+        &self,
+        name: &str,
+        bvh: &Path,
+        labels: &Path,
+        camera: Camera,
+        build: Option<Build>,
+    ) -> anyhow::Result<Video> {
         self.step(&format!("render {name}"));
         let out = self.path(name);
-        let args = ["render", &arg(bvh), "-o", &arg(&out), "--labels", &arg(labels), "--force"];
-        invoke(&[&args[..], options].concat())?;
+        let (motion, activities) = read_take(bvh, Some(labels), &RetargetOptions::default(), &mut ())?;
+        let filming = Filming { build, ..Filming::new(camera) };
+        film(&motion, activities.as_deref(), &filming, &out, &|| {}).with_context(|| bvh.display().to_string())?;
         Ok(Video { name: name.to_string(), frames: out.join("frames"), truth: out.join("truth.csv") })
     }
 
@@ -249,18 +267,16 @@ impl Work {
     fn synth(
         &self,
         name: &str,
-        activities: &str,
-        reps: u32,
+        activities: &[Activity],
+        reps: usize,
         seed: u64,
         retime: f64,
-        camera: &str,
+        preset: Preset,
     ) -> anyhow::Result<Video> {
         self.step(&format!("synth {name}"));
         let dir = self.path(&format!("{name}-motion"));
-        let reps = reps.to_string();
-        let seed = seed.to_string();
-        invoke(&["synth", "-o", &arg(&dir), "--sequence", activities, "--reps", &reps, "--seed", &seed])?;
-        let bvh = dir.join("sequence.bvh");
+        files::write_sequence(&dir, activities, &SynthOptions { repetitions: reps, seed, ..SynthOptions::default() })?;
+        let bvh = dir.join(files::SEQUENCE_FILE);
         if retime != 1.0 {
             let mut motion = imitate::mocap::bvh::read_bvh(&bvh)?;
             motion.frame_time_s /= retime;
@@ -268,7 +284,7 @@ impl Work {
             imitate::mocap::bvh::write_bvh(&motion, &mut bytes)?;
             std::fs::write(&bvh, bytes).with_context(|| format!("{}: cannot write", bvh.display()))?;
         }
-        self.render(name, &bvh, &dir.join("labels.csv"), camera)
+        self.render(name, &bvh, &dir.join(files::LABELS_FILE), preset)
     }
 
     /// The folder of the run of `video` tracked `how` with `seed`.
@@ -301,6 +317,18 @@ impl Work {
         self.done.borrow_mut().insert(key, scored.clone());
         self.bar.inc(1);
         Ok(scored)
+    }
+
+    /// Learns a vocabulary from `inputs` labelled by `labels` with `vocab
+    /// build`'s defaults (one cluster per label when `by_label`) and saves
+    /// it as `out`.
+    fn build_vocabulary(&self, inputs: Vec<PathBuf>, labels: &Path, by_label: bool, out: &Path) -> anyhow::Result<()> {
+        let mut params = BuildParams::standard();
+        params.cluster = ClusterParams::default().by_label(by_label).check()?;
+        let takes = Takes { inputs, labels: Some(labels.to_path_buf()), ..Takes::default() };
+        let Built { mut vocabulary, .. } = learn::build(&takes, &params, &mut ())?;
+        vocabulary.save(out)?;
+        Ok(())
     }
 
     /// The vocabulary at `vocab`, read once.
@@ -464,7 +492,7 @@ fn evaluate(args: &Args, global: Global, dir: &Path) -> anyhow::Result<Outcome> 
         + 2
         + 6 * plan.bodies.len();
     work.bar.set_length((settings * plan.seeds.len()) as u64);
-    let front = work.synth("front", SEQUENCE, 3, held_out, 1.0, "front")?;
+    let front = work.synth("front", SEQUENCE, 3, held_out, 1.0, Preset::Front)?;
     let first = work.run_dir(&front, How::eq10(plan.particles[0]), plan.seeds[0]);
     let mut trials = vec![
         trial_one(&work, &plan, &front, &first)?,
@@ -526,18 +554,18 @@ fn evaluate(args: &Args, global: Global, dir: &Path) -> anyhow::Result<Outcome> 
 }
 
 /// The activities of trial one, the viewpoints and the demo.
-pub(super) const SEQUENCE: &str = "circles,wave-h,wave-v";
+pub(super) const SEQUENCE: &[Activity] = &[Activity::Circles, Activity::WaveH, Activity::WaveV];
 
 /// A vocabulary of the paper's four activities, 12 synthetic repetitions
 /// each.
 fn paper_vocabulary(work: &Work, seed: u64) -> anyhow::Result<PathBuf> {
     work.step("vocabulary");
     let train = work.path("train");
-    let seed = seed.to_string();
-    let activities = "circles,wave-h,wave-v,punch";
-    invoke(&["synth", "-o", &arg(&train), "--activities", activities, "--reps", "12", "--seed", &seed])?;
+    let activities = [Activity::Circles, Activity::WaveH, Activity::WaveV, Activity::Punch];
+    let options = SynthOptions { repetitions: 12, seed, ..SynthOptions::default() };
+    files::write_activities(&train, &activities, &options, &mut |_, _| {})?;
     let vocab = work.path("paper.vocab");
-    invoke(&["vocab", "build", &arg(&train), "--labels", &arg(&train.join("labels.csv")), "-o", &arg(&vocab)])?;
+    work.build_vocabulary(vec![train.clone()], &train.join(files::LABELS_FILE), false, &vocab)?;
     Ok(vocab)
 }
 
@@ -606,14 +634,14 @@ fn speed(work: &Work, plan: &Plan, held_out: u64) -> anyhow::Result<Trial> {
     let mut fastest = None;
     for &s in &plan.speeds {
         // At least 4 s of motion at every speed.
-        let reps = ((4.0 * s).ceil() as u32).clamp(2, 40);
-        let video = work.synth(&format!("speed{s}"), "wave-h", reps, held_out, s, "front")?;
+        let reps = ((4.0 * s).ceil() as usize).clamp(2, 40);
+        let video = work.synth(&format!("speed{s}"), &[Activity::WaveH], reps, held_out, s, Preset::Front)?;
         let (hand, peak) = hand_speed(&read_track(&video.truth)?);
         let params = serde_json::json!({"speed": s, "hand_m_per_s": hand, "hand_p95_m_per_s": peak});
         settings.extend(cone_and_line(work, &video, &format!("{s}× ({hand:.2}, {peak:.2} m/s)"), params)?);
         fastest = Some((video, s));
     }
-    let punch = work.synth("punch", "punch", 4, held_out, 4.0, "front")?;
+    let punch = work.synth("punch", &[Activity::Punch], 4, held_out, 4.0, Preset::Front)?;
     let (hand, peak) = hand_speed(&read_track(&punch.truth)?);
     let params = serde_json::json!({"speed": 4.0, "hand_m_per_s": hand, "hand_p95_m_per_s": peak, "activity": "punch"});
     settings.extend(cone_and_line(work, &punch, &format!("punch 4× ({hand:.2}, {peak:.2} m/s)"), params)?);
@@ -650,10 +678,11 @@ fn speed(work: &Work, plan: &Plan, held_out: u64) -> anyhow::Result<Trial> {
 fn viewpoint(work: &Work, front: &Video, held_out: u64) -> anyhow::Result<Trial> {
     let mut settings = Vec::new();
     let mut overhead = None;
-    for camera in ["front", "side", "overhead"] {
-        let video = match camera {
-            "front" => front.clone(),
-            _ => work.synth(camera, SEQUENCE, 3, held_out, 1.0, camera)?,
+    for preset in [Preset::Front, Preset::Side, Preset::Overhead] {
+        let camera = preset.name();
+        let video = match preset {
+            Preset::Front => front.clone(),
+            _ => work.synth(camera, SEQUENCE, 3, held_out, 1.0, preset)?,
         };
         for (n, series) in [(6, "6 particles"), (25, "25 particles")] {
             let params = serde_json::json!({"camera": camera, "particles": n});
@@ -737,25 +766,20 @@ fn real_trial(work: &Work, real: &Path) -> anyhow::Result<Option<Trial>> {
     let real_labels = work.path("real-labels.csv");
     std::fs::write(&real_labels, relabelled).with_context(|| format!("{}: cannot write", real_labels.display()))?;
     let vocab = work.path("real.vocab");
-    let mut build: Vec<String> = vec!["vocab".into(), "build".into()];
-    build.extend(takes.iter().map(|p| arg(p)));
-    build.extend(["--labels".into(), arg(&real_labels), "-o".into(), arg(&vocab)]);
-    invoke(&build)?;
+    work.build_vocabulary(takes.clone(), &real_labels, false, &vocab)?;
     let real_work = work.with_vocab(vocab);
     let mut settings = Vec::new();
     for take in tracked {
         let name = take.trim_end_matches(".bvh");
         let bvh = real.join(take);
-        let mut video = real_work.render(&format!("real-{name}"), &bvh, &real_labels, "front")?;
+        let mut video = real_work.render(&format!("real-{name}"), &bvh, &real_labels, Preset::Front)?;
         // A silhouette cannot tell front from back: film a performer who
         // faces away from behind.
         if read_track(&video.truth)?.joints.first().is_some_and(faces_away) {
-            let camera = Camera::preset(imitate::vision::camera::Preset::Front, 160, 120)?;
-            let mut spec = camera.spec().clone();
+            let mut spec = Preset::Front.spec(DEFAULT_SIZE.0, DEFAULT_SIZE.1);
             spec.position[2] = -spec.position[2];
-            let behind = work.path("behind.json");
-            std::fs::write(&behind, Camera::new(spec, "behind")?.to_json())?;
-            video = real_work.render(&format!("real-{name}"), &bvh, &real_labels, &arg(&behind))?;
+            let behind = Camera::new(spec, "behind")?;
+            video = real_work.film(&format!("real-{name}"), &bvh, &real_labels, behind, None)?;
         }
         let label = Label { series: "eq. 10", x: name.into(), params: serde_json::json!({"take": take}) };
         settings.push(real_work.setting(&video, label, How::standard())?);

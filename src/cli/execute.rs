@@ -4,12 +4,9 @@ use super::retarget::RetargetArgs;
 use super::segment::take;
 use super::{Global, Outcome, UsageError, note, progress, refuse_nonempty};
 use anyhow::Context;
-use imitate::fsutil::{write_atomic, write_dir_atomic};
-use imitate::mocap::bvh::write_bvh;
 use imitate::params::{InvalidField, Params};
-use imitate::sim::execute::{ExecuteParams, ExecuteParamsError, Summary, bind_pose_start, execute};
+use imitate::sim::execute::{ExecuteParams, ExecuteParamsError, bind_pose_start, execute};
 use imitate::sim::humanoid::{Base, Gains};
-use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -66,16 +63,6 @@ fn parse_gains(text: &str) -> Result<Gains, UsageError> {
     Ok(Gains { kp_per_s2: kp.trim().parse().map_err(|_| bad())?, kd_per_s: kd.trim().parse().map_err(|_| bad())? })
 }
 
-/// summary.json: the input and the frames left out of it, then the
-/// execution's numbers.
-#[derive(serde::Serialize)]
-struct SummaryFile<'a> {
-    input: String,
-    skipped_frames: usize,
-    #[serde(flatten)]
-    summary: &'a Summary,
-}
-
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let base = if args.fixed_base { Base::Fixed } else { Base::Free };
     let params =
@@ -119,25 +106,9 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let seconds = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
-    let summary = &execution.summary;
-    let json = serde_json::to_string_pretty(&SummaryFile { input: input.clone(), skipped_frames: args.skip, summary })
-        .expect("the summary serializes")
-        + "\n";
     let output = args.output.display().to_string();
-    let io = |e: std::io::Error| anyhow::anyhow!("{output}: cannot write: {e}");
-    write_dir_atomic(
-        &args.output,
-        |dir| {
-            write_atomic(&dir.join("executed.bvh"), |w| write_bvh(&execution.motion().to_bvh(), w)).map_err(io)?;
-            write_atomic(&dir.join("execution.csv"), |w| {
-                w.write_all(execution.csv_header().as_bytes())?;
-                (0..execution.frames.len()).try_for_each(|k| w.write_all(execution.csv_row(k).as_bytes()))
-            })
-            .map_err(io)?;
-            std::fs::write(dir.join("summary.json"), json).map_err(io)
-        },
-        io,
-    )?;
+    execution.write(&args.output, &input, args.skip).map_err(|e| anyhow::anyhow!("{output}: cannot write: {e}"))?;
+    let summary = &execution.summary;
     let fell = match summary.fell_at_s {
         Some(t) => format!(", fell at {t:.2} s"),
         None if base == Base::Free => ", stayed up".to_string(),

@@ -4,16 +4,9 @@ use super::retarget::RetargetArgs;
 use super::segment::take;
 use super::{Global, Outcome, UsageError, camera, note, progress, refuse_nonempty};
 use anyhow::Context;
-use imitate::fsutil::{write_atomic, write_dir_atomic};
-use imitate::vision::color::{Scene, Surface};
 use imitate::vision::figure::{Build, BuildError};
-use imitate::vision::mask::Mask;
-use imitate::vision::noise::{Level, Noise};
-use imitate::vision::render::draw;
-use imitate::vision::shape::capsules;
-use imitate::vision::truth;
-use rayon::prelude::*;
-use std::io::Write;
+use imitate::vision::filming::{Filming, film};
+use imitate::vision::noise::Level;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -81,114 +74,38 @@ fn parse_size(text: &str) -> Result<(u32, u32), UsageError> {
     Ok((w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?))
 }
 
-/// One frame as an 8-bit grey PNG: 0 outside, 255 on the body.
-fn png(mask: &Mask) -> Vec<u8> {
-    let grey: Vec<u8> = mask.pixels().iter().map(|&p| p * 255).collect();
-    encode(&grey, mask.width(), mask.height(), image::ExtendedColorType::L8)
-}
-
-/// Pixels as a PNG, compressed fast: frames are many.
-fn encode(pixels: &[u8], width: usize, height: usize, kind: image::ExtendedColorType) -> Vec<u8> {
-    imitate::fsutil::png(pixels, width as u32, height as u32, kind, imitate::fsutil::PngEffort::Fast)
-}
-
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
-    if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 1000.0) {
-        return Err(UsageError(format!("--fps {}: must be above 0 and at most 1000", args.fps)).into());
-    }
     let (width, height) = parse_size(&args.size)?;
     let camera = camera(&args.camera, width, height)?;
     let build = Build::choose(&args.body).map_err(|e| match e {
         BuildError::Unknown(_) => UsageError(format!("--body: {e}")).into(),
         e => anyhow::Error::from(e),
     })?;
+    let filming = Filming { camera, fps: args.fps, build, noise: args.noise, color: args.color, seed: args.seed };
+    if filming.check().is_err() {
+        return Err(UsageError(format!("--fps {}: must be above 0 and at most 1000", args.fps)).into());
+    }
     refuse_nonempty(&args.output, args.force)?;
     let started = Instant::now();
     let (motion, labels) = take(&args.input, args.labels.as_deref(), &args.retarget, global)?;
-    let motion = match &build {
-        Some(build) => motion.on_body(&build.body()),
-        None => motion,
-    };
-    let times: Vec<f64> = (0..).map(|k| k as f64 / args.fps).take_while(|&t| t <= motion.duration_s() + 1e-9).collect();
-    let bar = progress(global, times.len() as u64, "render");
-    let noise = Noise::new(args.noise, args.seed, &camera, times.len(), args.fps);
-    let scene = args.color.then(|| Scene::new(&camera, args.seed));
-    let output = args.output.display().to_string();
-    let io = |e: std::io::Error| anyhow::anyhow!("{output}: cannot write: {e}");
-    let (width, height) = (camera.width(), camera.height());
-    write_dir_atomic(
-        &args.output,
-        |dir| {
-            let frames = dir.join("frames");
-            std::fs::create_dir(&frames).map_err(io)?;
-            let color = dir.join("color");
-            if let Some(scene) = &scene {
-                std::fs::create_dir(&color).map_err(io)?;
-                let room = encode(scene.background(), width, height, image::ExtendedColorType::Rgb8);
-                std::fs::write(dir.join("background.png"), room).map_err(io)?;
-            }
-            let rows: Vec<String> = times
-                .par_iter()
-                .enumerate()
-                .map_init(
-                    || Mask::new(width, height),
-                    |mask, (k, &t)| {
-                        let pose = motion.pose_at(t);
-                        let world = motion.body.forward(&pose);
-                        mask.clear();
-                        let surface: Box<dyn Surface> = match &build {
-                            Some(build) => {
-                                let figure = build.figure(&motion.body, &world);
-                                figure.draw(&camera, mask);
-                                Box::new(figure)
-                            }
-                            None => {
-                                let parts = capsules(&motion.body, &world);
-                                draw(&camera, &parts, mask);
-                                Box::new(parts)
-                            }
-                        };
-                        if let Some(scene) = &scene {
-                            let rgb = scene.shade(k, &world, surface.as_ref(), mask, &noise);
-                            let encoded = encode(&rgb, width, height, image::ExtendedColorType::Rgb8);
-                            std::fs::write(color.join(format!("{k:06}.png")), encoded)?;
-                        }
-                        noise.apply(k, &world, mask);
-                        std::fs::write(frames.join(format!("{k:06}.png")), png(mask))?;
-                        bar.inc(1);
-                        let source = ((t / motion.frame_time_s).round() as usize).min(motion.poses.len() - 1);
-                        let activity = labels.as_ref().map(|l| l[source].as_str());
-                        Ok(truth::row(k, t, activity, &pose, &world))
-                    },
-                )
-                .collect::<std::io::Result<_>>()
-                .map_err(io)?;
-            std::fs::write(dir.join("camera.json"), camera.to_json()).map_err(io)?;
-            if let Some(build) = &build {
-                std::fs::write(dir.join("body.toml"), build.to_toml()).map_err(io)?;
-            }
-            write_atomic(&dir.join("truth.csv"), |w| {
-                w.write_all(truth::header().as_bytes())?;
-                rows.iter().try_for_each(|r| w.write_all(r.as_bytes()))
-            })
-            .map_err(io)
-        },
-        io,
-    )
-    .with_context(|| args.input.display().to_string())?;
+    let bar = progress(global, filming.times(&motion).len() as u64, "render");
+    let filmed = film(&motion, labels.as_deref(), &filming, &args.output, &|| bar.inc(1))
+        .with_context(|| args.input.display().to_string())?;
     bar.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
     note(
         global,
         &format!(
-            "{}: {} frames at {} Hz, {width}×{height}, {}, noise {}{} → {output} in {seconds:.2} s ({:.0} frames/s)",
+            "{}: {filmed} frames at {} Hz, {}×{}, {}, noise {}{} → {} in {seconds:.2} s ({:.0} frames/s)",
             args.input.display(),
-            times.len(),
             args.fps,
-            build.as_ref().map_or("the tracker's capsules".to_string(), |b| format!("body `{}`", b.name)),
+            filming.camera.width(),
+            filming.camera.height(),
+            filming.build.as_ref().map_or("the tracker's capsules".to_string(), |b| format!("body `{}`", b.name)),
             args.noise.name(),
             if args.color { ", color" } else { "" },
-            times.len() as f64 / seconds
+            args.output.display(),
+            filmed as f64 / seconds
         ),
     );
     Ok(Outcome::Success)

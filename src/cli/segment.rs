@@ -3,11 +3,11 @@
 use super::learn::{SegmentArgs, TakesArgs};
 use super::retarget::RetargetArgs;
 use super::{Global, Notes, Outcome, note, progress};
-use anyhow::{Context, bail};
+use anyhow::Context;
 use imitate::mocap::pose::Motion;
 use imitate::mocap::retarget::RetargetOptions;
 use imitate::vocab::corpus::Corpus;
-use imitate::vocab::learn::{read_corpus, segment, takes_named};
+use imitate::vocab::learn::{read_corpus, read_take, segment, takes_named};
 use imitate::vocab::lineage::Lineage;
 use std::path::{Path, PathBuf};
 
@@ -34,13 +34,10 @@ pub fn take(
     retarget: &RetargetArgs,
     global: Global,
 ) -> anyhow::Result<(Motion, Option<Vec<String>>)> {
-    if input.is_dir() {
-        bail!("{}: is a folder; give one BVH file", input.display());
-    }
-    let mut corpus = load_corpus(&[input.to_path_buf()], labels, &retarget.options()?, global)?;
-    let recording = corpus.takes.pop().expect("one input gives one take");
-    let names = recording.labels.map(|ids| ids.iter().map(|&id| corpus.label(id).to_string()).collect());
-    Ok((recording.motion, names))
+    let bar = progress(global, 1, "read");
+    let read = read_take(input, labels, &retarget.options()?, &mut Notes(global))?;
+    bar.finish_and_clear();
+    Ok(read)
 }
 
 /// Reads the takes under a progress bar, notes on stderr.

@@ -1,13 +1,9 @@
 //! `imitate synth`: canonical BVH of the demonstrator's activities.
 
 use super::{Global, Outcome, note, progress};
-use anyhow::Context;
-use imitate::fsutil::write_atomic;
 use imitate::mocap::body::Proportions;
-use imitate::mocap::bvh::write_bvh;
-use imitate::mocap::synth::{Activity, SynthOptions, Take, activity_take, sequence_take};
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use imitate::mocap::synth::{Activity, SynthOptions, Take, files};
+use std::path::PathBuf;
 
 /// Synthesize human-like canonical motion of the paper's activities.
 ///
@@ -86,53 +82,26 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         fps: args.fps,
         seed: args.seed,
     };
-    std::fs::create_dir_all(&args.output).with_context(|| format!("cannot create {}", args.output.display()))?;
-    let labels_path = args.output.join("labels.csv");
     if !args.sequence.is_empty() {
-        let take = sequence_take(&args.sequence, &options);
-        let path = args.output.join("sequence.bvh");
-        write_take(&path, &take)?;
-        write_atomic(&labels_path, |w| {
-            writeln!(w, "frame,activity")?;
-            for (frame, label) in take.labels.iter().enumerate() {
-                writeln!(w, "{frame},{label}")?;
-            }
-            Ok(())
-        })
-        .with_context(|| format!("cannot write {}", labels_path.display()))?;
-        note(global, &format!("wrote {} ({}) and {}", path.display(), describe(&take), labels_path.display()));
+        let take = files::write_sequence(&args.output, &args.sequence, &options)?;
+        let (path, labels) = (args.output.join(files::SEQUENCE_FILE), args.output.join(files::LABELS_FILE));
+        note(global, &format!("wrote {} ({}) and {}", path.display(), describe(&take), labels.display()));
         return Ok(Outcome::Success);
     }
 
     let activities = if args.activities.is_empty() { Activity::ALL.to_vec() } else { args.activities };
     let bar = progress(global, activities.len() as u64, "synth");
-    let mut rows = Vec::new();
-    for activity in activities {
-        let take = activity_take(activity, &options);
-        let file = format!("{}.bvh", activity.name());
-        write_take(&args.output.join(&file), &take)?;
+    let mut written = Vec::new();
+    files::write_activities(&args.output, &activities, &options, &mut |path, take| {
         bar.inc(1);
-        rows.push((file, activity.name(), describe(&take)));
-    }
+        written.push(format!("wrote {} ({})", path.display(), describe(take)));
+    })?;
     bar.finish_and_clear();
-    write_atomic(&labels_path, |w| {
-        writeln!(w, "file,activity")?;
-        for (file, activity, _) in &rows {
-            writeln!(w, "{file},{activity}")?;
-        }
-        Ok(())
-    })
-    .with_context(|| format!("cannot write {}", labels_path.display()))?;
-    for (file, _, summary) in &rows {
-        note(global, &format!("wrote {} ({summary})", args.output.join(file).display()));
+    for line in written {
+        note(global, &line);
     }
-    note(global, &format!("wrote {}", labels_path.display()));
+    note(global, &format!("wrote {}", args.output.join(files::LABELS_FILE).display()));
     Ok(Outcome::Success)
-}
-
-fn write_take(path: &Path, take: &Take) -> anyhow::Result<()> {
-    let bvh = take.motion.to_bvh();
-    write_atomic(path, |w| write_bvh(&bvh, w)).with_context(|| format!("cannot write {}", path.display()))
 }
 
 fn describe(take: &Take) -> String {

@@ -5,13 +5,16 @@
 use super::anthropometry::body_mass_kg;
 use super::humanoid::{Base, Gains, Humanoid};
 use super::targets::{JointTarget, Targets, TargetsError, motorized};
-use crate::fsutil::{round6, rounded};
+use crate::fsutil::{round6, rounded, write_atomic, write_dir_atomic};
 use crate::mocap::body::{JOINTS, Joint, Kind};
+use crate::mocap::bvh::write_bvh;
 use crate::mocap::math::angle_between;
 use crate::mocap::pose::{Motion, Pose};
 use crate::params::{InvalidField, Params};
 use glam::{DQuat, DVec3};
 use std::fmt::Write;
+use std::io::Write as _;
+use std::path::Path;
 
 /// How to execute a trajectory; [`ExecuteParams::check`] validates it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -355,7 +358,38 @@ pub fn bind_pose_start(motion: &Motion) -> Option<(Joint, f64, f64)> {
     (first > 45f64.to_radians() && first > 3.0 * typical).then_some((joint, first, typical))
 }
 
+/// summary.json: the input and the frames left out of it, then the
+/// execution's numbers.
+#[derive(serde::Serialize)]
+struct SummaryFile<'a> {
+    input: &'a str,
+    skipped_frames: usize,
+    #[serde(flatten)]
+    summary: &'a Summary,
+}
+
 impl Execution {
+    /// Writes the execution's folder (docs/formats.md, "Execution"):
+    /// executed.bvh, execution.csv and summary.json, which names `input`
+    /// and the `skipped` frames left out of it. The folder replaces `dir`
+    /// only once whole.
+    pub fn write(&self, dir: &Path, input: &str, skipped: usize) -> std::io::Result<()> {
+        let summary = SummaryFile { input, skipped_frames: skipped, summary: &self.summary };
+        let json = serde_json::to_string_pretty(&summary).expect("the summary serializes") + "\n";
+        write_dir_atomic(
+            dir,
+            |dir| {
+                write_atomic(&dir.join("executed.bvh"), |w| write_bvh(&self.motion().to_bvh(), w))?;
+                write_atomic(&dir.join("execution.csv"), |w| {
+                    w.write_all(self.csv_header().as_bytes())?;
+                    (0..self.frames.len()).try_for_each(|k| w.write_all(self.csv_row(k).as_bytes()))
+                })?;
+                std::fs::write(dir.join("summary.json"), json)
+            },
+            |e| e,
+        )
+    }
+
     /// What the humanoid did, on the canonical skeleton, at the
     /// trajectory's frames.
     pub fn motion(&self) -> Motion {

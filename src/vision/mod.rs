@@ -6,6 +6,7 @@ pub mod camera;
 pub mod color;
 pub mod distance;
 pub mod figure;
+pub mod filming;
 pub mod frames;
 pub mod keypoints;
 pub mod light;

@@ -4,6 +4,7 @@
 //! lineage and tells a [`Listener`] what it found.
 
 use crate::mocap::mapping::{MappingError, UserMapping};
+use crate::mocap::pose::Motion;
 use crate::mocap::retarget::{RetargetOptions, UpAxis};
 use crate::vocab::cluster::{Choice, ClusterError, ValidClusterParams, best};
 use crate::vocab::corpus::{self, Corpus, CorpusError, read_labels};
@@ -62,6 +63,8 @@ pub enum LearnError {
     Mapping(#[from] MappingError),
     #[error(transparent)]
     Corpus(#[from] CorpusError),
+    #[error("{0}: is a folder; give one BVH file")]
+    Folder(String),
     /// A stage failed on the takes named.
     #[error("{takes}: {source}")]
     Stage { takes: String, source: BuildError },
@@ -110,6 +113,23 @@ pub fn read_corpus(
         }
     }
     Ok(corpus)
+}
+
+/// One take read and retargeted, with each frame's activity when `labels`
+/// are given.
+pub fn read_take(
+    input: &Path,
+    labels: Option<&Path>,
+    options: &RetargetOptions,
+    listener: &mut dyn Listener,
+) -> Result<(Motion, Option<Vec<String>>), LearnError> {
+    if input.is_dir() {
+        return Err(LearnError::Folder(input.display().to_string()));
+    }
+    let mut corpus = read_corpus(&[input.to_path_buf()], labels, options, listener)?;
+    let recording = corpus.takes.pop().expect("one input gives one take");
+    let names = recording.labels.map(|ids| ids.iter().map(|&id| corpus.label(id).to_string()).collect());
+    Ok((recording.motion, names))
 }
 
 /// The takes a corpus was read from, for error messages: up to three

@@ -3,13 +3,13 @@
 //! performance style the vocabulary never saw.
 
 use super::{How, Label, Work};
-use crate::cli::{arg, invoke};
 use imitate::report::corpora::{
     TrackedTake, TrackingSelection, corpora_table, corpus_folders, held_out_table, load_corpora, tracking_selection,
     vocabularies_table,
 };
 use imitate::report::eval::{Measure, Table, Trial};
 use imitate::report::metrics::latent_projection_mm;
+use imitate::vision::camera::Preset;
 use imitate::vocab::pipeline::BuildParams;
 use imitate::vocab::vocabulary::Vocabulary;
 use serde_json::json;
@@ -48,10 +48,7 @@ pub(super) fn section(work: &Work, root: &Path) -> anyhow::Result<(Vec<Table>, O
 fn held_out_tracking(work: &Work, selection: &TrackingSelection) -> anyhow::Result<(Trial, Table)> {
     work.step("real motion capture: vocabulary of the other styles");
     let vocab = work.path("mocap-styles.vocab");
-    let mut build: Vec<String> = vec!["vocab".into(), "build".into()];
-    build.extend(selection.training.iter().map(|p| arg(p)));
-    build.extend(["--labels".into(), arg(&selection.labels), "-o".into(), arg(&vocab)]);
-    invoke(&build)?;
+    work.build_vocabulary(selection.training.clone(), &selection.labels, false, &vocab)?;
     let vocabulary = Vocabulary::load(&vocab)?;
     let styles_work = work.with_vocab(vocab);
     let mut settings = Vec::new();
@@ -61,8 +58,9 @@ fn held_out_tracking(work: &Work, selection: &TrackingSelection) -> anyhow::Resu
         let file = take.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
         rows.push(vec![activity.clone(), file.clone(), format!("{projected:.1}")]);
         metrics.push(json!({"activity": activity, "take": file, "latent_projection_mm": projected}));
-        for camera in ["front", "side"] {
-            let video = styles_work.render(&format!("mocap-{camera}-{activity}"), take, &selection.labels, camera)?;
+        for preset in [Preset::Front, Preset::Side] {
+            let camera = preset.name();
+            let video = styles_work.render(&format!("mocap-{camera}-{activity}"), take, &selection.labels, preset)?;
             let params = json!({"camera": camera, "activity": activity, "take": file, "particles": PARTICLES});
             let label = Label { series: camera, x: activity.clone(), params };
             settings.push(styles_work.setting(&video, label, How::eq10(PARTICLES))?);

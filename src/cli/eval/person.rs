@@ -4,8 +4,11 @@
 //! calibration, and through a camera estimated from the frames.
 
 use super::{How, Label, Plan, Video, Work};
+use imitate::mocap::synth::files;
 use imitate::report::eval::{Measure, Trial};
-use imitate::vision::camera::{CameraSpec, Preset};
+use imitate::vision::camera::{Camera, CameraSpec, Preset};
+use imitate::vision::figure::Build;
+use imitate::vision::filming::DEFAULT_SIZE;
 
 /// A camera unlike the preset, as a person might set one up: 1.7 m high,
 /// 3.2 m from the person along the floor, a 49° vertical field of view,
@@ -17,24 +20,22 @@ fn raised_camera() -> CameraSpec {
         fy: focal,
         position: [0.0, 1.7, 3.2],
         look_at: [0.0, 1.2, 0.0],
-        ..Preset::Front.spec(160, 120)
+        ..Preset::Front.spec(DEFAULT_SIZE.0, DEFAULT_SIZE.1)
     }
 }
 
 /// The bodies × cameras, each tracked three ways.
 pub(super) fn trial(work: &Work, plan: &Plan, front: &Video) -> anyhow::Result<Trial> {
     let motion = work.path(&format!("{}-motion", front.name));
-    let (bvh, labels) = (motion.join("sequence.bvh"), motion.join("labels.csv"));
-    let raised = work.path("raised-camera.json");
-    let json = serde_json::to_string_pretty(&raised_camera()).expect("a camera serializes");
-    std::fs::write(&raised, json).map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", raised.display()))?;
-    let raised = super::arg(&raised);
+    let (bvh, labels) = (motion.join(files::SEQUENCE_FILE), motion.join(files::LABELS_FILE));
+    let front_camera = Camera::preset(Preset::Front, DEFAULT_SIZE.0, DEFAULT_SIZE.1)?;
+    let raised = Camera::new(raised_camera(), "raised")?;
     let mut settings = Vec::new();
     let mut shown = None;
     for body in &plan.bodies {
-        for (camera_name, camera) in [("front", "front"), ("raised", raised.as_str())] {
+        for (camera_name, camera) in [("front", &front_camera), ("raised", &raised)] {
             let name = format!("person-{body}-{camera_name}");
-            let video = work.render_with(&name, &bvh, &labels, &["--camera", camera, "--body", body])?;
+            let video = work.film(&name, &bvh, &labels, camera.clone(), Build::choose(body)?)?;
             let told = How::eq10(plan.person_particles);
             let series = [
                 ("calibrated", told),

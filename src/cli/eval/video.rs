@@ -9,7 +9,6 @@
 use super::How;
 use super::Work;
 use crate::cli::score::{keypoint_agreement, silhouette_agreement};
-use crate::cli::{arg, invoke};
 use anyhow::Context;
 use imitate::report::eval::{Table, TimingRow};
 use imitate::report::metrics::SETTLE_S;
@@ -91,10 +90,8 @@ pub(super) fn mocap_vocabulary(work: &Work, mocap: &Path) -> anyhow::Result<Path
     let labels_path = work.path("mocap-labels.csv");
     std::fs::write(&labels_path, labels).with_context(|| format!("{}: cannot write", labels_path.display()))?;
     let vocab = work.path("mocap.vocab");
-    let mut build: Vec<String> = vec!["vocab".into(), "build".into()];
-    build.extend(folders.iter().flat_map(|f| f.files.iter().map(|p| arg(p))));
-    build.extend(["--labels".into(), arg(&labels_path), "--by-label".into(), "-o".into(), arg(&vocab)]);
-    invoke(&build)?;
+    let takes = folders.iter().flat_map(|f| f.files.iter().cloned()).collect();
+    work.build_vocabulary(takes, &labels_path, true, &vocab)?;
     Ok(vocab)
 }
 

@@ -11,6 +11,7 @@
 //! acceleration are therefore continuous everywhere, with `noise = 0`.
 
 mod activity;
+pub mod files;
 mod rig;
 
 pub use activity::Activity;
