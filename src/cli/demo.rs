@@ -1,11 +1,13 @@
 //! `imitate demo`: the main job on what ships with the program.
 
 use super::eval::SEQUENCE;
-use super::{Global, Outcome, UsageError, arg, invoke, note, progress};
+use super::{Global, Outcome, UsageError, note, progress};
 use anyhow::{Context, bail};
 use imitate::mocap::retarget::RetargetOptions;
 use imitate::mocap::synth::{SynthOptions, files};
 use imitate::params::{InvalidField, Params};
+use imitate::report::metrics::SETTLE_S;
+use imitate::report::write::{ReportInputs, write_report};
 use imitate::sim::execute::{ExecuteParams, execute};
 use imitate::track::clip::{ClipOptions, track_clip};
 use imitate::vision::camera::{Camera, Preset};
@@ -98,23 +100,26 @@ fn demo(args: &Args, options: &ClipOptions, global: Global) -> anyhow::Result<Ou
     let (played, _) = read_take(&trajectory, None, &RetargetOptions::default(), &mut ())?;
     let execution = execute(&played, &ExecuteParams::default().check()?, || {})?;
     execution
-        .write(&humanoid, &arg(&trajectory), 0)
+        .write(&humanoid, &trajectory.display().to_string(), 0)
         .with_context(|| format!("{}: cannot write", humanoid.display()))?;
     bar.inc(1);
     step("score and report");
     let truth = video.join("truth.csv");
-    invoke(&["report", &arg(&run), "--truth", &arg(&truth), "--execution", &arg(&humanoid), "-o", &arg(&report)])?;
+    let inputs = ReportInputs {
+        truth: Some(truth),
+        execution: Some(humanoid.clone()),
+        settle_s: SETTLE_S,
+        ..ReportInputs::default()
+    };
+    let metrics = write_report(&run, &inputs, &report)?.expect("the truth was given");
     bar.inc(1);
     bar.finish_and_clear();
 
-    let metrics: serde_json::Value = serde_json::from_slice(&std::fs::read(report.join("metrics.json"))?)?;
-    let number = |key: &str| metrics[key].as_f64().unwrap_or(f64::NAN);
-    let execution: serde_json::Value = serde_json::from_slice(&std::fs::read(humanoid.join("summary.json"))?)?;
-    let stood = match execution["fell_at_s"].as_f64() {
+    let stood = match execution.summary.fell_at_s {
         Some(t) => format!("fell at {t:.1} s"),
         None => "stayed up".to_string(),
     };
-    let frames = metrics["frames"].as_u64().unwrap_or(0);
+    let frames = metrics.frames;
     note(
         global,
         &format!(
@@ -125,11 +130,11 @@ fn demo(args: &Args, options: &ClipOptions, global: Global) -> anyhow::Result<Ou
             imitate::vocab::vocabulary::Vocabulary::load(&vocab)?.primitives().len(),
             args.particles,
             started.elapsed().as_secs_f64(),
-            number("upper_body_mm"),
-            100.0 * number("recognition_accuracy_settled"),
-            number("hand_mm"),
+            metrics.upper_body_mm,
+            100.0 * metrics.recognition.recognition_accuracy_settled.unwrap_or(f64::NAN),
+            metrics.hand_mm,
             report.join("index.html").display(),
-            execution["rms_error_deg"].as_f64().unwrap_or(f64::NAN),
+            execution.summary.rms_error_deg,
             humanoid.join("executed.bvh").display()
         ),
     );

@@ -4,8 +4,7 @@ mod mocap;
 mod person;
 mod video;
 
-use super::report::{silhouettes, tracked_camera};
-use super::{Global, Outcome, UsageError, arg, refuse_nonempty};
+use super::{Global, Outcome, UsageError, refuse_nonempty};
 use anyhow::Context;
 use imitate::fsutil::write_dir_atomic;
 use imitate::mocap::retarget::RetargetOptions;
@@ -17,6 +16,7 @@ use imitate::report::filmstrip::{filmstrip, pick_frames};
 use imitate::report::metrics::{SETTLE_S, Track, score};
 use imitate::report::read_track;
 use imitate::report::run::Run;
+use imitate::report::write::{silhouettes, tracked_camera};
 use imitate::track::clip::{Baseline, CameraChoice, ClipOptions, track_clip_with};
 use imitate::track::filter::FilterParams;
 use imitate::vision::camera::{Camera, Preset};
@@ -295,7 +295,7 @@ impl Work {
     /// Tracks `video` `how` with `seed`, and scores it (once).
     fn track(&self, video: &Video, how: How, seed: u64) -> anyhow::Result<RunScore> {
         let out = self.run_dir(video, how, seed);
-        let key = arg(&out);
+        let key = out.display().to_string();
         if let Some(done) = self.done.borrow().get(&key) {
             return Ok(done.clone());
         }
@@ -539,7 +539,7 @@ fn evaluate(args: &Args, global: Global, dir: &Path) -> anyhow::Result<Outcome> 
     };
     let confusion = &first_metrics.recognition.confusion;
     let files = eval_report(&provenance, &trials, &tables, confusion, &table_timing, &machine());
-    let shown = arg(&args.output);
+    let shown = args.output.display().to_string();
     let io = |e: std::io::Error| anyhow::anyhow!("{shown}: cannot write: {e}");
     let write = |d: &Path| files.iter().try_for_each(|(name, bytes)| std::fs::write(d.join(name), bytes)).map_err(io);
     write_dir_atomic(&args.output, write, io)?;

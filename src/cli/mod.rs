@@ -100,20 +100,6 @@ pub fn main() -> ExitCode {
     }
 }
 
-/// Runs `imitate ARGS…` in this process, quietly: `eval` and `demo` chain
-/// the very commands a user would type, with their defaults and checks.
-pub fn invoke<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> anyhow::Result<()> {
-    let words = std::iter::once("imitate".as_ref()).chain(args.iter().map(AsRef::as_ref)).chain(["-q".as_ref()]);
-    let cli = Cli::try_parse_from(words).map_err(|e| anyhow::anyhow!("{}", e.to_string().trim()))?;
-    match dispatch(cli)? {
-        Outcome::Success => Ok(()),
-        Outcome::SomeFailed => bail!(
-            "{}: some inputs failed",
-            args.iter().map(|a| a.as_ref().to_string_lossy()).collect::<Vec<_>>().join(" ")
-        ),
-    }
-}
-
 fn dispatch(cli: Cli) -> anyhow::Result<Outcome> {
     match cli.command {
         Command::Inspect(args) => inspect::run(args, cli.global),
@@ -227,11 +213,6 @@ pub fn camera(choice: &str, width: u32, height: u32) -> anyhow::Result<Camera> {
         ))
         .into()),
     }
-}
-
-/// A path as a command-line argument, for commands run through [`invoke`].
-pub fn arg(path: &Path) -> String {
-    path.display().to_string()
 }
 
 /// Refuses an output folder that holds something, unless `force`.

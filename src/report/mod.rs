@@ -14,6 +14,7 @@ pub mod metrics;
 pub mod page;
 pub mod plot;
 pub mod run;
+pub mod write;
 
 use crate::mocap::body::{JOINTS, Joint};
 use crate::vision::truth::position_columns;
