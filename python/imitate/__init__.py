@@ -147,6 +147,8 @@ def score(run: PathLike, truth: PathLike, settle: float = 0.5) -> Dict[str, Any]
 
 def execute(
     motion: Union[Motion, PathLike],
+    out: Optional[PathLike] = None,
+    force: bool = False,
     frame: str = "pandas",
     fixed_base: bool = False,
     balance: bool = True,
@@ -164,10 +166,13 @@ def execute(
     ``fixed_base`` holds the pelvis in place; ``balance=False`` leaves the
     ankles to the trajectory; ``gains`` are the motors' stiffness and
     damping (KP 1/s², KD 1/s); ``rate`` the physics steps a second;
-    ``skip`` leaves out the first frames (a bind pose)."""
+    ``skip`` leaves out the first frames (a bind pose). With ``out``, the
+    execution's folder (executed.bvh, execution.csv, summary.json) is
+    written there too; a folder that holds something is refused unless
+    ``force``."""
     _check_frame(frame)
     if not isinstance(motion, Motion):
         motion = read_bvh(motion, up, mapping)
-    text = _imitate.execute_table(motion, fixed_base, balance, tuple(gains), rate, skip)
+    text = _imitate.execute_table(motion, out, force, fixed_base, balance, tuple(gains), rate, skip)
     return _table(text, frame)
 

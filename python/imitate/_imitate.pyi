@@ -190,6 +190,8 @@ def track_frames(
 def score_run(run: _Path, truth: _Path, settle: float = 0.5) -> str: ...
 def execute_table(
     motion: Motion,
+    out: Optional[_Path] = None,
+    force: bool = False,
     fixed_base: bool = False,
     balance: bool = True,
     gains: Tuple[float, float] = (10000.0, 200.0),

@@ -662,12 +662,16 @@ pub fn score_run(py: Python<'_>, run: PathBuf, truth: PathBuf, settle: f64) -> P
 }
 
 /// Plays a motion on the simulated humanoid as ``imitate execute`` does
-/// and returns ``execution.csv``'s text.
+/// and returns ``execution.csv``'s text, writing the execution's folder
+/// to `out` when given.
 #[pyfunction]
-#[pyo3(signature = (motion, fixed_base=false, balance=true, gains=(10000.0, 200.0), rate=240.0, skip=0))]
+#[pyo3(signature = (motion, out=None, force=false, fixed_base=false, balance=true, gains=(10000.0, 200.0), rate=240.0, skip=0))]
+#[allow(clippy::too_many_arguments)]
 pub fn execute_table(
     py: Python<'_>,
     motion: &Motion,
+    out: Option<PathBuf>,
+    force: bool,
     fixed_base: bool,
     balance: bool,
     gains: (f64, f64),
@@ -686,9 +690,19 @@ pub fn execute_table(
         return Err(raise(Class::Options, format!("skip: {skip}: {} has only {frames} frames", motion.source), None));
     }
     trajectory.poses.drain(..skip.min(trajectory.poses.len()));
+    if let Some(out) = &out {
+        let label = out.display().to_string();
+        clip::refuse_nonempty(out, force).map_err(|e| raise(Class::Error, e.to_string(), Some(label)))?;
+    }
     let execution = py
         .detach(|| execute(&trajectory, &params, || {}))
         .map_err(|e| raise(Class::Error, format!("{}: {}", motion.source, imitate::describe(&e)), None))?;
+    if let Some(out) = &out {
+        let label = out.display().to_string();
+        execution
+            .write(out, &motion.source, skip)
+            .map_err(|e| raise(Class::Error, format!("{label}: cannot write: {e}"), Some(label.clone())))?;
+    }
     let mut csv = execution.csv_header();
     (0..execution.frames.len()).for_each(|k| csv.push_str(&execution.csv_row(k)));
     Ok(csv)

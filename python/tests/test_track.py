@@ -120,10 +120,14 @@ def test_score_is_the_cli_metrics(tmp_path, cli, clip, run_dir):
     assert metrics["upper_body_mm"] < 100
 
 
-def test_execute_returns_the_cli_execution_table(tmp_path, cli):
+def test_execute_returns_the_cli_execution_table_and_writes_its_folder(tmp_path, cli):
     cli("execute", "mocap/punch.bvh", "-o", tmp_path / "run", "--fixed-base")
-    table = imitate.execute("mocap/punch.bvh", fixed_base=True)
+    table = imitate.execute("mocap/punch.bvh", out=tmp_path / "mine", fixed_base=True)
     pd.testing.assert_frame_equal(table, read_csv(tmp_path / "run" / "execution.csv"))
+    for name in ["executed.bvh", "execution.csv", "summary.json"]:
+        assert (tmp_path / "mine" / name).read_bytes() == (tmp_path / "run" / name).read_bytes(), name
+    with pytest.raises(imitate.Error, match="exists and is not empty"):
+        imitate.execute("mocap/punch.bvh", out=tmp_path / "mine", fixed_base=True)
 
 
 def test_bad_inputs_name_the_file(tmp_path, cli, clip):
