@@ -3,7 +3,12 @@
 //! - `parse/1-core`: BVH text parsed on one core (target ≥ 150 MB/s);
 //! - `read+retarget/2-cores`: parse, analyse and retarget on two cores
 //!   (target ≥ 200,000 frames/s for the 31-joint, 96-channel CMU skeleton);
-//! - `write/canonical`: canonical BVH written to memory (reported only).
+//! - `write/canonical`: canonical BVH written to memory (reported only);
+//! - `read_folder/positions` (only when `IMITATE_MOCAP_DIR` is set): every
+//!   `.bvh` file of that folder read from disk, one after the other, and
+//!   put on the canonical body, then every frame's joint positions
+//!   (frames × 17 × 3): what the Python package's `read_bvh(path)` and
+//!   `positions()` do, the reference of `scripts/python-bench.sh`.
 //!
 //! The input is a CMU-like take generated here, so the benchmark runs
 //! without the real captures (they live outside the repository). Criterion
@@ -228,5 +233,39 @@ fn mocap(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, mocap);
+/// `read_folder/positions`: the files of `IMITATE_MOCAP_DIR`, read and
+/// retargeted as `imitate retarget` reads them, and forward kinematics for
+/// every frame, the joint positions flattened into one array per file as
+/// `Motion.positions()` gives them.
+fn read_folder(c: &mut Criterion) {
+    use imitate::mocap::bvh::read_bvh;
+    let Ok(dir) = std::env::var("IMITATE_MOCAP_DIR") else { return };
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{dir}: {e}"))
+        .map(|entry| entry.expect("a folder entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")))
+        .collect();
+    files.sort();
+    let read = |path: &std::path::Path| {
+        let bvh = read_bvh(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let retargeter =
+            Retargeter::new(&bvh, &RetargetOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let motion = retargeter.retarget(&bvh);
+        let positions: Vec<f64> = motion
+            .poses
+            .iter()
+            .flat_map(|p| motion.body.forward(p).positions.into_iter().flat_map(|v| v.to_array()))
+            .collect();
+        positions
+    };
+    let frames: usize = files.iter().map(|f| read(f).len() / (imitate::mocap::body::JOINTS * 3)).sum();
+    eprintln!("{dir}: {} files, {frames} frames", files.len());
+    let mut group = c.benchmark_group("read_folder");
+    group.sampling_mode(criterion::SamplingMode::Flat).sample_size(10).warm_up_time(Duration::from_secs(1));
+    group.throughput(Throughput::Elements(frames as u64));
+    group.bench_function("positions", |b| b.iter(|| files.iter().map(|f| black_box(read(f)).len()).sum::<usize>()));
+    group.finish();
+}
+
+criterion_group!(benches, mocap, read_folder);
 criterion_main!(benches);
