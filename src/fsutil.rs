@@ -7,6 +7,36 @@ use std::fs;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+/// A folder that holds something where a new one was to be written.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}: exists and is not empty")]
+pub struct NotEmpty(pub String);
+
+/// Refuses to replace the folder `dir` when it holds something, unless
+/// `force`.
+pub fn refuse_nonempty(dir: &Path, force: bool) -> Result<(), NotEmpty> {
+    if !force && dir.read_dir().is_ok_and(|mut d| d.next().is_some()) {
+        return Err(NotEmpty(dir.display().to_string()));
+    }
+    Ok(())
+}
+
+/// A file or folder that could not be written, named.
+#[derive(Debug, thiserror::Error)]
+#[error("{path}: cannot write: {source}")]
+pub struct WriteError {
+    pub path: String,
+    pub source: io::Error,
+}
+
+impl WriteError {
+    /// Turns an I/O error met writing `path` into one that names it.
+    pub fn at(path: &Path) -> impl Fn(io::Error) -> WriteError {
+        let path = path.display().to_string();
+        move |source| WriteError { path: path.clone(), source }
+    }
+}
+
 /// Writes the file at `path` through `write`, atomically: readers see the
 /// old file or the complete new one, and an error leaves no file behind.
 pub fn write_atomic<F>(path: &Path, write: F) -> io::Result<()>

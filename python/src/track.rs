@@ -6,6 +6,7 @@ use crate::motion::{Motion, shape_error};
 use crate::vocab::{Vocabulary, vocab_failure};
 use crate::{Class, Options, failure, raise};
 use glam::DVec3;
+use imitate::fsutil::refuse_nonempty;
 use imitate::mocap::body::{DOF, JOINTS};
 use imitate::params::{InvalidField, Params};
 use imitate::report::metrics::{SETTLE_S, score};
@@ -625,7 +626,7 @@ pub fn track_frames(
     let out_label = out.as_ref().map(|o| o.display().to_string());
     let fail = |e: ClipError| clip_failure(&e, &options, &input_label, &vocab_label, out_label.as_deref());
     if let Some(out) = &out {
-        clip::refuse_nonempty(out, force).map_err(fail)?;
+        refuse_nonempty(out, force).map_err(|e| fail(e.into()))?;
     }
     py.detach(|| {
         let tracked = track_clip_with(&input, &vocab_path, vocabulary, &options, &mut |_| {})?;
@@ -691,17 +692,13 @@ pub fn execute_table(
     }
     trajectory.poses.drain(..skip.min(trajectory.poses.len()));
     if let Some(out) = &out {
-        let label = out.display().to_string();
-        clip::refuse_nonempty(out, force).map_err(|e| raise(Class::Error, e.to_string(), Some(label)))?;
+        refuse_nonempty(out, force).map_err(|e| failure(Class::Error, &e, Some(e.0.clone())))?;
     }
     let execution = py
         .detach(|| execute(&trajectory, &params, || {}))
         .map_err(|e| raise(Class::Error, format!("{}: {}", motion.source, imitate::describe(&e)), None))?;
     if let Some(out) = &out {
-        let label = out.display().to_string();
-        execution
-            .write(out, &motion.source, skip)
-            .map_err(|e| raise(Class::Error, format!("{label}: cannot write: {e}"), Some(label.clone())))?;
+        execution.write(out, &motion.source, skip).map_err(|e| failure(Class::Error, &e, Some(e.path.clone())))?;
     }
     let mut csv = execution.csv_header();
     (0..execution.frames.len()).for_each(|k| csv.push_str(&execution.csv_row(k)));

@@ -99,9 +99,7 @@ fn demo(args: &Args, options: &ClipOptions, global: Global) -> anyhow::Result<Ou
     let trajectory = run.join("trajectory.bvh");
     let (played, _) = read_take(&trajectory, None, &RetargetOptions::default(), &mut ())?;
     let execution = execute(&played, &ExecuteParams::default().check()?, || {})?;
-    execution
-        .write(&humanoid, &trajectory.display().to_string(), 0)
-        .with_context(|| format!("{}: cannot write", humanoid.display()))?;
+    execution.write(&humanoid, &trajectory.display().to_string(), 0)?;
     bar.inc(1);
     step("score and report");
     let truth = video.join("truth.csv");

@@ -106,8 +106,8 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let seconds = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
+    execution.write(&args.output, &input, args.skip)?;
     let output = args.output.display().to_string();
-    execution.write(&args.output, &input, args.skip).map_err(|e| anyhow::anyhow!("{output}: cannot write: {e}"))?;
     let summary = &execution.summary;
     let fell = match summary.fell_at_s {
         Some(t) => format!(", fell at {t:.2} s"),

@@ -21,7 +21,6 @@ mod synth;
 mod track;
 mod vocab;
 
-use anyhow::bail;
 use clap::{Parser, Subcommand};
 use imitate::vision::camera::{Camera, Preset};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -217,8 +216,6 @@ pub fn camera(choice: &str, width: u32, height: u32) -> anyhow::Result<Camera> {
 
 /// Refuses an output folder that holds something, unless `force`.
 pub fn refuse_nonempty(output: &Path, force: bool) -> anyhow::Result<()> {
-    if !force && output.read_dir().is_ok_and(|mut d| d.next().is_some()) {
-        bail!("{}: exists and is not empty; choose another folder or pass --force to replace it", output.display());
-    }
-    Ok(())
+    imitate::fsutil::refuse_nonempty(output, force)
+        .map_err(|e| anyhow::anyhow!("{e}; choose another folder or pass --force to replace it"))
 }

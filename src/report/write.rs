@@ -1,7 +1,7 @@
 //! One tracking run as a report folder: what `imitate report` writes and
 //! `demo` ends with (docs/formats.md, "Reports").
 
-use crate::fsutil::write_dir_atomic;
+use crate::fsutil::{WriteError, write_dir_atomic};
 use crate::report::filmstrip::{MAX_FRAMES, Observed, pick_frames};
 use crate::report::imitation::read_imitation;
 use crate::report::metrics::{Metrics, ReportError, score};
@@ -44,8 +44,8 @@ pub enum WriteReportError {
     /// The frames hold another number of frames than the run tracked.
     #[error("{input}: {found} frames, but the run tracked {tracked}; give the frames it tracked")]
     OtherFrames { input: String, found: usize, tracked: usize },
-    #[error("{path}: cannot write: {source}")]
-    Write { path: String, source: std::io::Error },
+    #[error(transparent)]
+    Write(#[from] WriteError),
 }
 
 /// Writes the report of the run in `run_dir` into `output` (replacing it
@@ -69,8 +69,8 @@ pub fn write_report(run_dir: &Path, inputs: &ReportInputs, output: &Path) -> Res
         let json = serde_json::to_string_pretty(m).expect("metrics are plain numbers and maps") + "\n";
         files.push(("metrics.json".into(), json.into_bytes()));
     }
-    let shown = output.display().to_string();
-    let io = |source: std::io::Error| WriteReportError::Write { path: shown.clone(), source };
+    let at = WriteError::at(output);
+    let io = |e: std::io::Error| WriteReportError::Write(at(e));
     write_dir_atomic(
         output,
         |dir| files.iter().try_for_each(|(name, bytes)| std::fs::write(dir.join(name), bytes)).map_err(io),

@@ -5,7 +5,7 @@
 use super::anthropometry::body_mass_kg;
 use super::humanoid::{Base, Gains, Humanoid};
 use super::targets::{JointTarget, Targets, TargetsError, motorized};
-use crate::fsutil::{round6, rounded, write_atomic, write_dir_atomic};
+use crate::fsutil::{WriteError, round6, rounded, write_atomic, write_dir_atomic};
 use crate::mocap::body::{JOINTS, Joint, Kind};
 use crate::mocap::bvh::write_bvh;
 use crate::mocap::math::angle_between;
@@ -373,7 +373,7 @@ impl Execution {
     /// executed.bvh, execution.csv and summary.json, which names `input`
     /// and the `skipped` frames left out of it. The folder replaces `dir`
     /// only once whole.
-    pub fn write(&self, dir: &Path, input: &str, skipped: usize) -> std::io::Result<()> {
+    pub fn write(&self, dir: &Path, input: &str, skipped: usize) -> Result<(), WriteError> {
         let summary = SummaryFile { input, skipped_frames: skipped, summary: &self.summary };
         let json = serde_json::to_string_pretty(&summary).expect("the summary serializes") + "\n";
         write_dir_atomic(
@@ -388,6 +388,7 @@ impl Execution {
             },
             |e| e,
         )
+        .map_err(WriteError::at(dir))
     }
 
     /// What the humanoid did, on the canonical skeleton, at the

@@ -2,7 +2,7 @@
 //! vocabulary in, the run folder out ([`crate::track::run`]). What
 //! `imitate track` and Python's `imitate.track` run.
 
-use crate::fsutil::{write_atomic, write_dir_atomic};
+use crate::fsutil::{NotEmpty, refuse_nonempty, write_atomic, write_dir_atomic};
 use crate::mocap::body::Body;
 use crate::mocap::bvh::write_bvh;
 use crate::mocap::pose::{Motion, Pose};
@@ -280,8 +280,8 @@ pub enum ClipError {
     NoFrames(String),
     #[error("{vocab}: {source}")]
     Tracker { vocab: String, source: TrackError },
-    #[error("{0}: exists and is not empty")]
-    NotEmpty(String),
+    #[error(transparent)]
+    NotEmpty(#[from] NotEmpty),
     #[error("{dir}: cannot write: {source}")]
     Write { dir: String, source: std::io::Error },
 }
@@ -408,14 +408,6 @@ impl TrackedClip {
             io,
         )
     }
-}
-
-/// Refuses an output folder that holds something, unless `force`.
-pub fn refuse_nonempty(dir: &Path, force: bool) -> Result<(), ClipError> {
-    if !force && dir.read_dir().is_ok_and(|mut d| d.next().is_some()) {
-        return Err(ClipError::NotEmpty(dir.display().to_string()));
-    }
-    Ok(())
 }
 
 /// What follows the person: the primitives' filters, or the baseline.

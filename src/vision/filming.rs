@@ -2,7 +2,7 @@
 //! render` writes, and what `eval` and `demo` make their videos with
 //! (docs/formats.md, "Frame input" and "Truth").
 
-use crate::fsutil::{PngEffort, png, write_atomic, write_dir_atomic};
+use crate::fsutil::{PngEffort, WriteError, png, write_atomic, write_dir_atomic};
 use crate::mocap::pose::Motion;
 use crate::vision::camera::Camera;
 use crate::vision::color::{Scene, Surface};
@@ -63,8 +63,8 @@ impl Filming {
 pub enum FilmingError {
     #[error("fps: must be above 0 and at most 1000, not {0}")]
     Fps(f64),
-    #[error("{path}: cannot write: {source}")]
-    Write { path: String, source: std::io::Error },
+    #[error(transparent)]
+    Write(#[from] WriteError),
 }
 
 /// Films `motion` (with each source frame's activity in `labels`) into
@@ -87,8 +87,8 @@ pub fn film(
     let times = filming.times(&motion);
     let noise = Noise::new(filming.noise, filming.seed, camera, times.len(), fps);
     let scene = filming.color.then(|| Scene::new(camera, filming.seed));
-    let shown = out.display().to_string();
-    let io = |source: std::io::Error| FilmingError::Write { path: shown.clone(), source };
+    let at = WriteError::at(out);
+    let io = |e: std::io::Error| FilmingError::Write(at(e));
     let (width, height) = (camera.width(), camera.height());
     write_dir_atomic(
         out,
