@@ -109,6 +109,7 @@ def track(
     out: Optional[PathLike] = None,
     frame: str = "pandas",
     force: bool = False,
+    threads: Optional[int] = None,
     **options: Any,
 ) -> Any:
     """Tracks a clip as ``imitate track`` does and returns its frames.csv as
@@ -129,10 +130,12 @@ def track(
     ``background``, ``work_size=320``, ``baseline`` (``"full_space"``),
     ``keypoints``, ``observe`` (``"silhouette"``, ``"keypoints"``,
     ``"both"``), ``unexplained_below=0.5``. The GIL is released while it
-    tracks.
+    tracks, on ``threads`` threads of its own (default: every core; give
+    the share of cores the call has when several run side by side). The
+    result is the same whatever ``threads`` is.
     """
     _check_frame(frame)
-    text = _imitate.track_frames(input, vocab, out, force, **options)
+    text = _imitate.track_frames(input, vocab, out, force, threads, **options)
     return _table(text, frame)
 
 

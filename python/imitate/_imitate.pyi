@@ -161,6 +161,7 @@ class Tracker:
         height: Optional[float] = None,
         calibrate: bool = True,
         unexplained_below: float = 0.5,
+        threads: Optional[int] = None,
     ) -> None: ...
     def step(
         self, silhouette: Optional[npt.ArrayLike] = None, keypoints: Optional[npt.ArrayLike] = None
@@ -185,7 +186,12 @@ def segment(paths: Sequence[_Path], out: _Path, labels: Optional[_Path] = None, 
     """Segments takes as ``imitate segment TAKES -o OUT`` and writes the table."""
 
 def track_frames(
-    input: _Path, vocab: Union[Vocabulary, _Path], out: Optional[_Path] = None, force: bool = False, **options: Any
+    input: _Path,
+    vocab: Union[Vocabulary, _Path],
+    out: Optional[_Path] = None,
+    force: bool = False,
+    threads: Optional[int] = None,
+    **options: Any,
 ) -> str: ...
 def score_run(run: _Path, truth: _Path, settle: float = 0.5) -> str: ...
 def execute_table(

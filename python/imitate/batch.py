@@ -7,7 +7,9 @@
 ``segment`` DIR/<take>.csv (the table ``imitate segment`` writes); each
 result is what running that clip or take alone gives. The cluster is the
 one ``ray.init()`` finds from the environment (``RAY_ADDRESS``, or
-``--address``), else a local one of ``--workers`` CPUs. Each task's end is
+``--address``), else a local one of ``--workers`` CPUs. Each task asks for
+``--cpus-per-task`` CPUs (1) and runs on that many threads, so tasks side
+by side on one machine do not crowd one another. Each task's end is
 reported as it comes, a failed one with its clip named and its error;
 the others go on, and the exit code is 1 when any failed (2 for bad
 arguments).
@@ -68,6 +70,9 @@ def _parser() -> argparse.ArgumentParser:
         p.add_argument("-o", "--output", required=True, help="the folder results are written to")
         p.add_argument("--workers", type=int, help="CPUs of a local cluster (default: all)")
         p.add_argument("--address", help="a Ray cluster's address (default: RAY_ADDRESS, else a local cluster)")
+        p.add_argument(
+            "--cpus-per-task", type=int, default=1, help="CPUs each task asks for and threads it runs on (default: 1)"
+        )
 
     track = commands.add_parser("track", help="track clips (folders of frames or videos)")
     track.add_argument("inputs", nargs="+", metavar="CLIP")
@@ -111,12 +116,13 @@ def _tasks(args: argparse.Namespace) -> List[Tuple[str, Callable[..., str], Tupl
             options["work_size"] = args.work_size
         tasks = []
         for clip, name in zip(args.inputs, names):
-            each = dict(options, force=bool(args.force))
+            each = dict(options, force=bool(args.force), threads=args.cpus_per_task)
             if args.keypoints_dir:
                 each["keypoints"] = str(Path(args.keypoints_dir) / f"{name}.csv")
             tasks.append((clip, _track, (clip, str(out / name), args.vocab, each)))
         return tasks
     options = _options(args, ["labels", "method", "min_length", "max_length", "up", "mapping"])
+    options["threads"] = args.cpus_per_task
     return [(take, _segment, (take, str(out / f"{name}.csv"), options)) for take, name in zip(args.inputs, names)]
 
 
@@ -132,7 +138,10 @@ def _connect(args: argparse.Namespace) -> Any:
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if args.cpus_per_task < 1:
+        parser.error("--cpus-per-task: must be at least 1")
     try:
         ray = _connect(args)
     except ImportError:
@@ -140,7 +149,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 2
     Path(args.output).mkdir(parents=True, exist_ok=True)
     tasks = _tasks(args)
-    remote = ray.remote(num_cpus=1)(_run)
+    remote = ray.remote(num_cpus=args.cpus_per_task)(_run)
     pending = {remote.remote(job, *job_args): name for name, job, job_args in tasks}
     started, failed, done = time.monotonic(), 0, 0
     while pending:

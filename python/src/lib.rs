@@ -77,6 +77,30 @@ pub fn failure(class: Class, err: &(dyn StdError + 'static), path: Option<String
     raise(class, imitate::describe(err), path)
 }
 
+/// A pool of `threads` threads of its own for a call, or `None` for the
+/// shared pool over every core: a caller running several calls side by
+/// side (a Ray task of one CPU) keeps each to its share instead of every
+/// call spreading over every core at once.
+pub fn pool_of(threads: Option<usize>) -> PyResult<Option<rayon::ThreadPool>> {
+    match threads {
+        None => Ok(None),
+        Some(0) => Err(raise(Class::Options, "threads: must be at least 1 (or None for every core)".into(), None)),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map(Some)
+            .map_err(|e| raise(Class::Error, format!("threads: cannot start {n} threads: {e}"), None)),
+    }
+}
+
+/// Runs `work` on `pool`, or on the shared pool when there is none.
+pub fn run_on<T: Send>(pool: Option<&rayon::ThreadPool>, work: impl FnOnce() -> T + Send) -> T {
+    match pool {
+        Some(pool) => pool.install(work),
+        None => work(),
+    }
+}
+
 /// Keyword options taken one by one by name, each with its default; what
 /// is left at the end was never asked for and is refused, named.
 pub struct Options<'py> {

@@ -4,7 +4,7 @@
 
 use crate::motion::{Motion, shape_error};
 use crate::vocab::{Vocabulary, vocab_failure};
-use crate::{Class, Options, failure, raise};
+use crate::{Class, Options, failure, pool_of, raise, run_on};
 use glam::DVec3;
 use imitate::fsutil::refuse_nonempty;
 use imitate::mocap::body::{DOF, JOINTS};
@@ -272,6 +272,7 @@ pub struct Tracker {
     vocabulary: Arc<vocabulary::Vocabulary>,
     params: TrackParams,
     fps: f64,
+    pool: Option<rayon::ThreadPool>,
     state: Mutex<Following>,
 }
 
@@ -279,7 +280,7 @@ pub struct Tracker {
 impl Tracker {
     #[new]
     #[pyo3(signature = (vocab, camera=None, *, particles=6, lookahead=5, feedback=true, seed=0, fps=15.0,
-                        height=None, calibrate=true, unexplained_below=OpenSet::STANDARD.min_fit))]
+                        height=None, calibrate=true, unexplained_below=OpenSet::STANDARD.min_fit, threads=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -293,6 +294,7 @@ impl Tracker {
         height: Option<f64>,
         calibrate: bool,
         unexplained_below: f64,
+        threads: Option<usize>,
     ) -> PyResult<Tracker> {
         let options = ClipOptions {
             particles,
@@ -316,7 +318,7 @@ impl Tracker {
             );
             state.camera = Some(camera);
         }
-        Ok(Tracker { vocabulary, params, fps, state: Mutex::new(state) })
+        Ok(Tracker { vocabulary, params, fps, pool: pool_of(threads)?, state: Mutex::new(state) })
     }
 
     /// Tracks the next frame from what it shows: ``silhouette``, a mask of
@@ -358,7 +360,7 @@ impl Tracker {
         let points = keypoints.map(keypoints_of).transpose()?.flatten();
         let following = &mut *state;
         let tracker = following.tracker.as_mut().expect("made above");
-        let estimate = py.detach(|| tracker.step_seen(mask.as_ref(), points.as_ref()));
+        let estimate = py.detach(|| run_on(self.pool.as_ref(), || tracker.step_seen(mask.as_ref(), points.as_ref())));
         let frame = following.frame;
         following.frame += 1;
         let names: Vec<String> = self.vocabulary.primitives().iter().map(|p| p.name().to_string()).collect();
@@ -608,19 +610,21 @@ fn clip_options(options: &mut Options<'_>) -> PyResult<ClipOptions> {
 /// Tracks a clip as ``imitate track`` does and returns ``frames.csv``'s
 /// text, writing the run folder to ``out`` when given.
 #[pyfunction]
-#[pyo3(signature = (input, vocab, out=None, force=false, **options))]
+#[pyo3(signature = (input, vocab, out=None, force=false, threads=None, **options))]
 pub fn track_frames(
     py: Python<'_>,
     input: PathBuf,
     vocab: &Bound<'_, PyAny>,
     out: Option<PathBuf>,
     force: bool,
+    threads: Option<usize>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
     let mut given = Options::new(options, "track")?;
     let options = clip_options(&mut given)?;
     given.finish()?;
     options.check().map_err(|e| raise(Class::Options, options_naming(&e, options.focal), None))?;
+    let pool = pool_of(threads)?;
     let (vocabulary, vocab_path) = vocabulary_of(py, vocab)?;
     let (input_label, vocab_label) = (input.display().to_string(), vocab_path.display().to_string());
     let out_label = out.as_ref().map(|o| o.display().to_string());
@@ -629,11 +633,13 @@ pub fn track_frames(
         refuse_nonempty(out, force).map_err(|e| fail(e.into()))?;
     }
     py.detach(|| {
-        let tracked = track_clip_with(&input, &vocab_path, vocabulary, &options, &mut |_| {})?;
-        if let Some(out) = &out {
-            tracked.write(out, force)?;
-        }
-        Ok(tracked.frames_csv())
+        run_on(pool.as_ref(), || {
+            let tracked = track_clip_with(&input, &vocab_path, vocabulary, &options, &mut |_| {})?;
+            if let Some(out) = &out {
+                tracked.write(out, force)?;
+            }
+            Ok(tracked.frames_csv())
+        })
     })
     .map_err(fail)
 }

@@ -2,7 +2,7 @@
 //! of motion primitives, and looking inside them.
 
 use crate::motion::{shape_error, up_axis, warn};
-use crate::{Class, Options, failure, raise};
+use crate::{Class, Options, failure, pool_of, raise, run_on};
 use imitate::mocap::body::DOF;
 use imitate::params::{InvalidField, Params};
 use imitate::vocab::cluster::ClusterParams;
@@ -231,11 +231,12 @@ impl Vocabulary {
         let up = up_axis(options.take_optional::<String>("up")?.as_deref())?;
         let mapping: Option<PathBuf> = options.take_optional("mapping")?;
         let params = build_params(&mut options)?;
+        let pool = pool_of(options.take_optional("threads")?)?;
         options.finish()?;
         let takes = Takes { inputs: paths, labels, up, mapping };
         let mut warnings = Warnings::default();
         let built = py
-            .detach(|| learn::build(&takes, &params, &mut warnings))
+            .detach(|| run_on(pool.as_ref(), || learn::build(&takes, &params, &mut warnings)))
             .map_err(|e| learn_failure(&e, takes.mapping.as_deref()))?;
         warn(py, &warnings.0)?;
         Ok(Vocabulary::new(built.vocabulary, None))
@@ -492,17 +493,20 @@ pub fn segment(
     let up = up_axis(options.take_optional::<String>("up")?.as_deref())?;
     let mapping: Option<PathBuf> = options.take_optional("mapping")?;
     let params = segment_params(&mut options)?;
+    let pool = pool_of(options.take_optional("threads")?)?;
     options.finish()?;
     let takes = Takes { inputs: paths, labels, up, mapping };
     let mut warnings = Warnings::default();
     let written = py.detach(|| {
-        let retarget = takes.options().map_err(LearnError::from)?;
-        let corpus = learn::read_corpus(&takes.inputs, takes.labels.as_deref(), &retarget, &mut warnings)
-            .map_err(LearnError::from)?;
-        let lineage = Lineage::new(takes.settings(), params.params().clone());
-        let segments = learn::segment(&corpus, &params, lineage, &mut warnings)
-            .map_err(|source| LearnError::Stage { takes: learn::takes_named(&corpus), source })?;
-        Ok(segments.write(&out))
+        run_on(pool.as_ref(), || {
+            let retarget = takes.options().map_err(LearnError::from)?;
+            let corpus = learn::read_corpus(&takes.inputs, takes.labels.as_deref(), &retarget, &mut warnings)
+                .map_err(LearnError::from)?;
+            let lineage = Lineage::new(takes.settings(), params.params().clone());
+            let segments = learn::segment(&corpus, &params, lineage, &mut warnings)
+                .map_err(|source| LearnError::Stage { takes: learn::takes_named(&corpus), source })?;
+            Ok(segments.write(&out))
+        })
     });
     let written = written.map_err(|e: LearnError| learn_failure(&e, takes.mapping.as_deref()))?;
     warn(py, &warnings.0)?;

@@ -21,6 +21,10 @@ def test_track_returns_exactly_the_cli_frames_csv(tmp_path, clip, run_dir):
     frames = imitate.track(clip / "frames", "vocab/default.vocab")
     pd.testing.assert_frame_equal(frames, expected)
     assert list(frames.columns) == list(expected.columns)
+    # On one thread of its own, as a batch task runs it: the same table.
+    pd.testing.assert_frame_equal(imitate.track(clip / "frames", "vocab/default.vocab", threads=1), expected)
+    with pytest.raises(imitate.OptionsError, match="threads: must be at least 1"):
+        imitate.track(clip / "frames", "vocab/default.vocab", threads=0)
     # polars, and the run folder written as the CLI writes it.
     vocab = imitate.Vocabulary.load("vocab/default.vocab")
     table = imitate.track(clip / "frames", vocab, out=tmp_path / "run", frame="polars")
@@ -177,3 +181,6 @@ def test_trackers_in_threads_give_what_each_gives_alone(clip):
     with ThreadPoolExecutor(2) as pool:
         together = list(pool.map(follow, (1, 2)))
     assert all(np.array_equal(a, b) for a, b in zip(alone, together))
+    # A tracker on a pool of one thread of its own follows the same way.
+    tracker = imitate.Tracker("vocab/default.vocab", camera, seed=1, threads=1)
+    assert np.array_equal(np.stack([tracker.step(silhouette=m).joints for m in masks]), alone[0])

@@ -34,6 +34,10 @@ def test_options_are_the_cli_flags_and_give_the_same_file(tmp_path, cli):
     vocab.save(tmp_path / "py.vocab")
     assert (tmp_path / "py.vocab").read_bytes() == (tmp_path / "cli.vocab").read_bytes()
     assert len(vocab) == 3
+    # On one thread of its own: the same file.
+    one = imitate.Vocabulary.build(takes, k=3, seed=7, min_length=0.3, method="zvc", field_neighbors=6, threads=1)
+    one.save(tmp_path / "one.vocab")
+    assert (tmp_path / "one.vocab").read_bytes() == (tmp_path / "cli.vocab").read_bytes()
 
 
 def test_info_is_what_vocab_info_json_prints(default, cli):
