@@ -159,6 +159,7 @@ const BALANCE_MAX_RAD: f64 = 0.25;
 /// Every actuator's joint stays in the world it was put in.
 const JOINT: &str = "the humanoid's joints are never removed";
 const FEET: [Joint; 2] = [Joint::LeftAnkle, Joint::RightAnkle];
+const HIPS: [Joint; 2] = [Joint::LeftHip, Joint::RightHip];
 
 impl Humanoid {
     /// The humanoid of `body` in `pose`, every joint turning as `start`
@@ -309,13 +310,19 @@ impl Humanoid {
         self.world.step();
     }
 
-    /// Turns the ankles' `targets` so that the body tilts about its standing
-    /// feet to bring its centre of mass back over them: the ankle strategy
-    /// of human balance. The correction moves the capture point (the centre
-    /// of mass ahead by its velocity over the inverted pendulum's
-    /// frequency, √(g/h)) onto the middle of the soles touching the ground,
-    /// up to `BALANCE_MAX_RAD` of tilt. Nothing changes while no foot
-    /// stands.
+    /// Turns the standing legs' `targets` so that the body shifts over its
+    /// standing feet to bring its centre of mass back over them. The
+    /// correction moves the capture point (the centre of mass ahead by its
+    /// velocity over the inverted pendulum's frequency, √(g/h)) onto the
+    /// middle of the soles touching the ground, up to `BALANCE_MAX_RAD` of
+    /// tilt. Each standing leg tilts about its ankle by the same turn in
+    /// the world and its hip turns back by it, so the legs move as a
+    /// parallelogram: the pelvis and all above it shift without turning.
+    /// Tilting the whole body about the feet instead (the ankle strategy
+    /// alone) cannot shift it sideways while both feet stand, as turning
+    /// about one ankle's forward axis lifts the other foot (measured: 1 of
+    /// 23 real captures stayed up that way, falling sideways with the
+    /// ankles at their tilt limit). Nothing changes while no foot stands.
     pub fn balance(&self, targets: &mut [JointTarget; JOINTS]) {
         let standing: Vec<usize> = (0..2).filter(|&k| self.stands(FEET[k])).collect();
         if standing.is_empty() {
@@ -341,15 +348,21 @@ impl Humanoid {
         let height = (com.y - support.y).max(0.1);
         let capture = com + velocity / (GRAVITY_M_S2 / height).sqrt();
         let shift = DVec3::new(support.x - capture.x, 0.0, support.z - capture.z);
-        // Turning the body by θ about the feet moves a point h above them by
-        // θ × h·Y; θ = Y × shift / h moves the centre of mass by `shift`.
-        let tilt = (DVec3::Y.cross(shift) / height).clamp_length_max(BALANCE_MAX_RAD);
-        for foot in FEET {
+        // Turning a leg by θ about its ankle moves its hip, h above it, by
+        // θ × h·Y; θ = Y × shift / h moves the pelvis by `shift`.
+        let pelvis = self.rotation(Joint::Pelvis);
+        let hip_height =
+            (self.world.bodies[self.links[Joint::Pelvis.index()]].translation().as_dvec3().y - support.y).max(0.1);
+        let turn = DQuat::from_scaled_axis((DVec3::Y.cross(shift) / hip_height).clamp_length_max(BALANCE_MAX_RAD));
+        for k in standing {
+            let (foot, hip) = (FEET[k], HIPS[k]);
             let shank = self.rotation(foot.parent().expect("only the pelvis has no parent"));
-            let target = &mut targets[foot.index()];
-            // The shank turned by `tilt` in the world over a foot that stays.
-            let turned = shank.inverse() * DQuat::from_scaled_axis(-tilt) * shank * target.rotation;
-            target.rotation = clamp(foot, turned).0;
+            // The shank turned by `turn` in the world over a foot that stays,
+            let ankle = &mut targets[foot.index()];
+            ankle.rotation = clamp(foot, shank.inverse() * turn.inverse() * shank * ankle.rotation).0;
+            // and the thigh with it under a pelvis that stays.
+            let thigh = &mut targets[hip.index()];
+            thigh.rotation = clamp(hip, pelvis.inverse() * turn * pelvis * thigh.rotation).0;
         }
     }
 
@@ -585,5 +598,31 @@ mod tests {
         assert!(lean < 5f64.to_radians(), "the trunk leans {:.1}°", lean.to_degrees());
         assert!(FEET.iter().all(|&f| humanoid.stands(f)), "both feet on the ground");
         assert!(humanoid.largest_joint_gap_m() < 1e-3);
+    }
+
+    #[test]
+    fn leaning_the_trunk_sideways_the_legs_shift_the_pelvis_back_over_the_feet() {
+        let (_, mut humanoid) = rest_humanoid(Base::Free);
+        let start = humanoid.frame().position(Joint::Pelvis);
+        // Spine and chest bent 20° each to the left: the trunk's weight
+        // swings well off the middle of the feet.
+        let mut targets = [JointTarget::REST; JOINTS];
+        for j in [Joint::Spine, Joint::Chest] {
+            targets[j.index()].rotation = DQuat::from_rotation_z(20f64.to_radians());
+        }
+        for _ in 0..(5.0 / DT) as usize {
+            let mut asked = targets;
+            humanoid.balance(&mut asked);
+            humanoid.step(&asked, Gains::STANDARD);
+        }
+        let frame = humanoid.frame();
+        let pelvis = frame.position(Joint::Pelvis);
+        assert!(FEET.iter().all(|&f| humanoid.stands(f)), "both feet on the ground");
+        // Bending left (+Z turns +Y toward −X) moves the trunk to −X; the
+        // pelvis goes the other way, level.
+        assert!(pelvis.x - start.x > 0.02, "the pelvis went from {start} to {pelvis}");
+        let tilt = (frame.rotation(Joint::Pelvis) * DVec3::Y).angle_between(DVec3::Y);
+        assert!(tilt < 3f64.to_radians(), "the pelvis tilts {:.1}°", tilt.to_degrees());
+        assert!((pelvis.y - start.y).abs() < 0.03, "the pelvis went from {start} to {pelvis}");
     }
 }
