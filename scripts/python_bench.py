@@ -343,16 +343,16 @@ def measure_batch(args: argparse.Namespace) -> List[Dict[str, Any]]:
         stop_ray()
     sys.stderr.write(said)
     inside = re.search(r"done in ([0-9.]+) s", said)
+    same = all(
+        (out / c.stem / "frames.csv").read_bytes() == (args.work / "single" / c.stem / "frames.csv").read_bytes()
+        for c in clips
+    )
     # The same batch with no cluster running: the command starts a local
     # one of 2 CPUs and stops it, which the figure above leaves out.
     cold = dict(os.environ)
     cold.pop("RAY_ADDRESS", None)
     log(f"$ {' '.join(command)} --workers 2")
     cold_seconds, _ = timed([*command, "--workers", "2"], cold)
-    same = all(
-        (out / c.stem / "frames.csv").read_bytes() == (args.work / "single" / c.stem / "frames.csv").read_bytes()
-        for c in clips
-    )
     ratio = seconds / ideal(single)
     within = f"; {float(inside.group(1)):.1f} s from the first task to the last" if inside else ""
     return [
