@@ -3,7 +3,8 @@
 # reach"): `imitate execute` of every standing gesture take (wave-*,
 # raise-up-*, bow, bye, byebye, guide) and every walk (walk, walk-turn-*) of
 # ../shared/mocap/bandai's takes 001 and 002, and of every take of
-# ../shared/mocap/real, each as a new user runs it (no flags but the ones
+# ../shared/mocap/real (grouped by its labels.csv: standing, walking, moving
+# in place), each as a new user runs it (no flags but the ones
 # given here). Prints per group how many stay up, the RMS joint error of
 # those that do, and lists the falls; the table is also written to
 # WORK_DIR/execute-trials.md.
@@ -49,9 +50,16 @@ for take in "$bandai"/*.bvh; do
     play bandai-walking "$take"
   fi
 done
-for take in "$real"/*.bvh; do
-  play real "$take"
-done
+# real/'s labels.csv names each take's activity: punches, gestures and
+# waves are played standing; walks, jumps, kicks and dances move the feet.
+while IFS=, read -r file activity _; do
+  case "$activity" in
+    activity) ;;
+    punch|gesture|wave*) play real-standing "$real/$file" ;;
+    walk) play real-walking "$real/$file" ;;
+    *) play real-moving "$real/$file" ;;
+  esac
+done <"$real/labels.csv"
 
 python3 - "${flags[*]:-}" <<'PY'
 import json, sys

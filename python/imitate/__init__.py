@@ -157,7 +157,7 @@ def execute(
     balance: bool = True,
     gains: Tuple[float, float] = (10000.0, 200.0),
     rate: float = 240.0,
-    skip: int = 0,
+    skip: Optional[int] = None,
     up: Optional[str] = None,
     mapping: Optional[PathLike] = None,
 ) -> Any:
@@ -169,10 +169,11 @@ def execute(
     ``fixed_base`` holds the pelvis in place; ``balance=False`` leaves the
     ankles to the trajectory; ``gains`` are the motors' stiffness and
     damping (KP 1/s², KD 1/s); ``rate`` the physics steps a second;
-    ``skip`` leaves out the first frames (a bind pose). With ``out``, the
-    execution's folder (executed.bvh, execution.csv, summary.json) is
-    written there too; a folder that holds something is refused unless
-    ``force``."""
+    ``skip`` leaves out the first frames (by default the first one when it
+    is a bind pose, as ``imitate execute`` does; ``skip=0`` keeps it). With
+    ``out``, the execution's folder (executed.bvh, execution.csv,
+    summary.json) is written there too; a folder that holds something is
+    refused unless ``force``."""
     _check_frame(frame)
     if not isinstance(motion, Motion):
         motion = read_bvh(motion, up, mapping)

@@ -202,5 +202,5 @@ def execute_table(
     balance: bool = True,
     gains: Tuple[float, float] = (10000.0, 200.0),
     rate: float = 240.0,
-    skip: int = 0,
+    skip: Optional[int] = None,
 ) -> str: ...

@@ -11,7 +11,7 @@ use imitate::mocap::body::{DOF, JOINTS};
 use imitate::params::{InvalidField, Params};
 use imitate::report::metrics::{SETTLE_S, score};
 use imitate::report::{read_primitives, read_track};
-use imitate::sim::execute::{ExecuteParams, execute};
+use imitate::sim::execute::{ExecuteParams, execute, frames_to_skip};
 use imitate::sim::humanoid::{Base, Gains};
 use imitate::track::auto_camera::Focal;
 use imitate::track::clip::{self, CameraChoice, ClipError, ClipOptions, ClipOptionsError, track_clip_with};
@@ -672,7 +672,7 @@ pub fn score_run(py: Python<'_>, run: PathBuf, truth: PathBuf, settle: f64) -> P
 /// and returns ``execution.csv``'s text, writing the execution's folder
 /// to `out` when given.
 #[pyfunction]
-#[pyo3(signature = (motion, out=None, force=false, fixed_base=false, balance=true, gains=(10000.0, 200.0), rate=240.0, skip=0))]
+#[pyo3(signature = (motion, out=None, force=false, fixed_base=false, balance=true, gains=(10000.0, 200.0), rate=240.0, skip=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn execute_table(
     py: Python<'_>,
@@ -683,7 +683,7 @@ pub fn execute_table(
     balance: bool,
     gains: (f64, f64),
     rate: f64,
-    skip: usize,
+    skip: Option<usize>,
 ) -> PyResult<String> {
     let base = if fixed_base { Base::Fixed } else { Base::Free };
     let gains = Gains { kp_per_s2: gains.0, kd_per_s: gains.1 };
@@ -692,10 +692,10 @@ pub fn execute_table(
         raise(Class::Options, e.naming(keyword), None)
     })?;
     let mut trajectory = motion.motion.clone();
-    if skip >= trajectory.poses.len() && !trajectory.poses.is_empty() {
-        let frames = trajectory.poses.len();
-        return Err(raise(Class::Options, format!("skip: {skip}: {} has only {frames} frames", motion.source), None));
-    }
+    let Some((skip, _)) = frames_to_skip(&trajectory, skip) else {
+        let (asked, frames) = (skip.unwrap_or(0), trajectory.poses.len());
+        return Err(raise(Class::Options, format!("skip: {asked}: {} has only {frames} frames", motion.source), None));
+    };
     trajectory.poses.drain(..skip.min(trajectory.poses.len()));
     if let Some(out) = &out {
         refuse_nonempty(out, force).map_err(|e| failure(Class::Error, &e, Some(e.0.clone())))?;

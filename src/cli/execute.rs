@@ -5,7 +5,7 @@ use super::segment::take;
 use super::{Global, Outcome, UsageError, note, progress, refuse_nonempty};
 use anyhow::Context;
 use imitate::params::{InvalidField, Params};
-use imitate::sim::execute::{ExecuteParams, ExecuteParamsError, bind_pose_start, execute};
+use imitate::sim::execute::{ExecuteParams, ExecuteParamsError, execute, frames_to_skip};
 use imitate::sim::humanoid::{Base, Gains};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -45,10 +45,12 @@ pub struct Args {
     /// frame of the trajectory.
     #[arg(long, value_name = "HZ", default_value_t = 240.0, allow_hyphen_values = true)]
     pub rate: f64,
-    /// Leave out the trajectory's first N frames (a bind pose many motion
-    /// capture files start with, which no body can leave in one frame).
-    #[arg(long, value_name = "N", default_value_t = 0)]
-    pub skip: usize,
+    /// Leave out the trajectory's first N frames. By default the first
+    /// frame is left out when it is a bind pose (a T-pose many motion
+    /// capture files start with, which no body can leave in one frame),
+    /// and `execute` says so; --skip 0 keeps it.
+    #[arg(long, value_name = "N")]
+    pub skip: Option<usize>,
     #[command(flatten)]
     pub retarget: RetargetArgs,
     /// Replace the output folder if it exists.
@@ -77,28 +79,14 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             })?;
     refuse_nonempty(&args.output, args.force)?;
     let (mut motion, _) = take(&args.input, None, &args.retarget, global)?;
-    if args.skip >= motion.poses.len() && !motion.poses.is_empty() {
-        return Err(UsageError(format!(
-            "--skip {}: {} has only {} frames",
-            args.skip,
-            args.input.display(),
-            motion.poses.len()
-        ))
-        .into());
-    }
-    motion.poses.drain(..args.skip.min(motion.poses.len()));
     let input = args.input.display().to_string();
-    if let Some((joint, first, later)) = bind_pose_start(&motion) {
-        note(
-            global,
-            &format!(
-                "{input}: warning: {} turns {:.0}° from the first frame to the next, where nine in ten \
-                 later frames turn no joint more than {:.0}°: a bind pose? --skip 1 leaves it out",
-                joint.name(),
-                first.to_degrees(),
-                later.to_degrees()
-            ),
-        );
+    let Some((skip, bind_pose)) = frames_to_skip(&motion, args.skip) else {
+        let frames = motion.poses.len();
+        return Err(UsageError(format!("--skip {}: {input} has only {frames} frames", args.skip.unwrap_or(0))).into());
+    };
+    motion.poses.drain(..skip.min(motion.poses.len()));
+    if let Some(bind_pose) = bind_pose {
+        note(global, &format!("{input}: the first frame is left out as a bind pose ({bind_pose}); --skip 0 keeps it"));
     }
     let bar = progress(global, motion.poses.len() as u64, "execute");
     let started = Instant::now();
@@ -106,7 +94,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let seconds = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
-    execution.write(&args.output, &input, args.skip)?;
+    execution.write(&args.output, &input, skip)?;
     let output = args.output.display().to_string();
     let summary = &execution.summary;
     let fell = match summary.fell_at_s {
