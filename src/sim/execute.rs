@@ -5,11 +5,11 @@
 use super::anthropometry::body_mass_kg;
 use super::humanoid::{Base, Gains, Humanoid};
 use super::targets::{JointTarget, Targets, TargetsError, motorized};
-use crate::fsutil::{WriteError, round6, rounded, write_atomic, write_dir_atomic};
+use crate::fsutil::{WriteError, round6, rounded, rounded_option, write_atomic, write_dir_atomic};
 use crate::mocap::body::{JOINTS, Joint, Kind};
 use crate::mocap::bvh::write_bvh;
 use crate::mocap::math::angle_between;
-use crate::mocap::pose::{Motion, Pose};
+use crate::mocap::pose::{BodyFrame, Motion, Pose};
 use crate::params::{InvalidField, Params};
 use glam::{DQuat, DVec3};
 use std::fmt::Write;
@@ -97,6 +97,13 @@ pub struct ExecutedFrame {
     /// tilts (its turn in the world after its heading), which no motor
     /// drives.
     pub error_rad: [f64; JOINTS],
+    /// How far the capture point lay inside the support polygon, m
+    /// ([`super::balance::BalanceState::margin_m`]); `None` on a fixed base and while no
+    /// foot stands.
+    pub margin_m: Option<f64>,
+    /// The most the balance turned a joint's target away from the
+    /// trajectory's in the step that ended here, radians.
+    pub departure_rad: f64,
 }
 
 /// A trajectory played on the humanoid.
@@ -145,6 +152,18 @@ pub struct Summary {
     /// joints hold by the solver, so not exactly zero).
     #[serde(serialize_with = "rounded")]
     pub max_joint_gap_mm: f64,
+    /// The least the capture point lay inside the support polygon (m,
+    /// negative outside) over the frames after the first on which a foot
+    /// stood, before a fall; `None` on a fixed base or without such a
+    /// frame.
+    #[serde(serialize_with = "rounded_option")]
+    pub min_balance_margin_m: Option<f64>,
+    /// The balance's departure from the trajectory's targets
+    /// ([`ExecutedFrame::departure_rad`]) over the frames after the first.
+    #[serde(serialize_with = "rounded")]
+    pub departure_rms_deg: f64,
+    #[serde(serialize_with = "rounded")]
+    pub departure_max_deg: f64,
     pub fell: bool,
     pub fell_at_s: Option<f64>,
     pub joints: Vec<JointSummary>,
@@ -175,9 +194,11 @@ pub struct JointSummary {
 }
 
 /// The humanoid has fallen when its pelvis is below this share of its
-/// standing height, or its trunk leans further than [`FALLEN_LEAN_RAD`].
+/// standing height, when its trunk leans further than [`FALLEN_LEAN_RAD`]
+/// beyond the trajectory's own lean (a deep bow leans past 60° standing),
+/// or when its trunk or head touches the ground.
 const FALLEN_PELVIS_SHARE: f64 = 0.5;
-const FALLEN_LEAN_RAD: f64 = std::f64::consts::FRAC_PI_3;
+const FALLEN_LEAN_RAD: f64 = std::f64::consts::FRAC_PI_4;
 
 /// Plays `motion` on the humanoid of its body. `progress` hears of every
 /// frame done.
@@ -206,23 +227,37 @@ pub fn execute(
     let mut fell_at_s = None;
     let mut max_joint_gap_m = 0.0f64;
     let standing = motion.body.pelvis_height();
+    let asked_leans: Vec<f64> = (0..targets.frames()).map(|k| lean(&motion.body.forward(targets.pose(k)))).collect();
 
     let mut frames = Vec::with_capacity(targets.frames());
-    let mut record = |k: usize, humanoid: &Humanoid, torque: [DVec3; JOINTS]| {
+    let mut record = |k: usize, humanoid: &Humanoid, torque: [DVec3; JOINTS], departure_rad: f64| {
         let achieved = humanoid.pose();
         let asked = targets.pose(k);
         let mut error_rad = Joint::ALL.map(|j| angle_between(asked.local_rotation(j), achieved.local_rotation(j)));
         error_rad[Joint::Pelvis.index()] = angle_between(asked.tilt(), achieved.tilt());
-        frames.push(ExecutedFrame { time_s: k as f64 * frame_time, achieved, torque, error_rad });
+        let margin_m = (base == Base::Free).then(|| humanoid.balance_state().margin_m()).flatten();
+        frames.push(ExecutedFrame {
+            time_s: k as f64 * frame_time,
+            achieved,
+            torque,
+            error_rad,
+            margin_m,
+            departure_rad,
+        });
     };
-    record(0, &humanoid, torque);
+    record(0, &humanoid, torque, 0.0);
     progress();
     for k in 1..targets.frames() {
+        let mut departure_rad = 0.0;
         for s in 1..=steps_per_frame {
             let time_s = (k - 1) as f64 * frame_time + s as f64 * dt;
             targets.sample(time_s, &mut asked);
             if balance {
+                let wanted = asked;
                 humanoid.balance(&mut asked);
+                departure_rad = motorized()
+                    .map(|j| angle_between(wanted[j.index()].rotation, asked[j.index()].rotation))
+                    .fold(0.0, f64::max);
             }
             humanoid.step(&asked, gains);
             humanoid.torques(&mut torque, &mut at_limit);
@@ -230,11 +265,11 @@ pub fn execute(
                 peak[j.index()] = peak[j.index()].max(torque[j.index()].length());
                 limited_steps[j.index()] += usize::from(at_limit[j.index()]);
             }
-            if fell_at_s.is_none() && base == Base::Free && fallen(&humanoid, standing) {
+            if fell_at_s.is_none() && base == Base::Free && fallen(&humanoid, standing, asked_leans[k]) {
                 fell_at_s = Some(time_s);
             }
         }
-        record(k, &humanoid, torque);
+        record(k, &humanoid, torque, departure_rad);
         max_joint_gap_m = max_joint_gap_m.max(humanoid.largest_joint_gap_m());
         progress();
     }
@@ -278,6 +313,13 @@ pub fn execute(
         clamped_frames: targets.frames_clamped(),
         feet_levelled_deg: feet_levelled_rad.map(|r| round6(r.to_degrees())),
         max_joint_gap_mm: max_joint_gap_m * 1e3,
+        min_balance_margin_m: scored
+            .iter()
+            .take_while(|f| fell_at_s.is_none_or(|t| f.time_s < t))
+            .filter_map(|f| f.margin_m)
+            .min_by(f64::total_cmp),
+        departure_rms_deg: rms_deg(&mut scored.iter().map(|f| f.departure_rad)),
+        departure_max_deg: max_deg(&mut scored.iter().map(|f| f.departure_rad)),
         fell: fell_at_s.is_some(),
         fell_at_s,
         joints,
@@ -324,11 +366,20 @@ fn level_feet(motion: &Motion) -> (Motion, [f64; 2]) {
     (out, turned)
 }
 
-fn fallen(humanoid: &Humanoid, standing_pelvis_m: f64) -> bool {
+/// The angle between the trunk (pelvis to neck) and the vertical.
+fn lean(frame: &BodyFrame) -> f64 {
+    (frame.position(Joint::Neck) - frame.position(Joint::Pelvis)).angle_between(DVec3::Y)
+}
+
+/// Whether the humanoid has fallen where the trajectory leans its trunk by
+/// `asked_lean_rad`.
+fn fallen(humanoid: &Humanoid, standing_pelvis_m: f64, asked_lean_rad: f64) -> bool {
     let frame = humanoid.frame();
-    let pelvis = frame.position(Joint::Pelvis);
-    let trunk = frame.position(Joint::Neck) - pelvis;
-    pelvis.y < FALLEN_PELVIS_SHARE * standing_pelvis_m || trunk.angle_between(DVec3::Y) > FALLEN_LEAN_RAD
+    frame.position(Joint::Pelvis).y < FALLEN_PELVIS_SHARE * standing_pelvis_m
+        || lean(&frame) > asked_lean_rad + FALLEN_LEAN_RAD
+        || [Joint::Pelvis, Joint::Spine, Joint::Chest, Joint::Neck, Joint::Head]
+            .into_iter()
+            .any(|j| humanoid.touches_ground(j))
 }
 
 /// The joint that turns most from pose `a` to pose `b`, and by how much,
@@ -354,7 +405,11 @@ pub fn bind_pose_start(motion: &Motion) -> Option<BindPose> {
     let mut later: Vec<f64> = poses[1..].windows(2).map(|w| largest_turn(&w[0], &w[1]).1).collect();
     later.sort_by(f64::total_cmp);
     let typical = later[(later.len() * 9 / 10).min(later.len() - 1)];
-    (first > 45f64.to_radians() && first > 3.0 * typical).then_some(BindPose { joint, turn_rad: first, typical_rad: typical })
+    (first > 45f64.to_radians() && first > 3.0 * typical).then_some(BindPose {
+        joint,
+        turn_rad: first,
+        typical_rad: typical,
+    })
 }
 
 /// A bind pose found at the start of a trajectory ([`bind_pose_start`]).
@@ -447,6 +502,7 @@ impl Execution {
             }
             columns.push(format!("{}_error_deg", j.name()));
         }
+        columns.extend(["balance_margin_m", "departure_deg"].map(String::from));
         columns.join(",") + "\n"
     }
 
@@ -477,6 +533,8 @@ impl Execution {
             }
             write!(line, ",{:.4}", f.error_rad[j.index()].to_degrees()).expect(INFALLIBLE);
         }
+        let margin = f.margin_m.map_or(String::new(), |m| format!("{m:.6}"));
+        write!(line, ",{margin},{:.4}", f.departure_rad.to_degrees()).expect(INFALLIBLE);
         line + "\n"
     }
 }
@@ -488,5 +546,34 @@ fn numbers(j: Joint) -> Vec<String> {
     match j.kind() {
         Kind::Hinge { .. } => vec![j.name().to_string()],
         Kind::Ball { .. } => ["x", "y", "z"].map(|axis| format!("{}_{axis}", j.name())).to_vec(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mocap::body::Body;
+    use std::f64::consts::FRAC_PI_3;
+
+    /// The standard body bowing: spine and chest each bent forward by
+    /// `each_deg`.
+    fn bow(body: &Body, each_deg: f64) -> Pose {
+        let mut local = [DQuat::IDENTITY; JOINTS];
+        for j in [Joint::Spine, Joint::Chest] {
+            local[j.index()] = DQuat::from_rotation_x(each_deg.to_radians());
+        }
+        Pose::from_rotations(Pose::rest(body).root, &local)
+    }
+
+    #[test]
+    fn a_deep_bow_is_a_fall_only_when_the_trajectory_does_not_bow() {
+        let body = Body::standard();
+        let pose = bow(&body, 60.0);
+        let asked = lean(&body.forward(&pose));
+        assert!(asked > FRAC_PI_3, "the bow leans {:.0}°", asked.to_degrees());
+        let humanoid = Humanoid::new(&body, Base::Free, &pose, &[JointTarget::REST; JOINTS], 1.0 / 240.0);
+        let standing = body.pelvis_height();
+        assert!(!fallen(&humanoid, standing, asked), "bowing as asked");
+        assert!(fallen(&humanoid, standing, 0.0), "bowing where the trajectory stands upright");
     }
 }

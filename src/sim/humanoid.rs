@@ -14,7 +14,7 @@
 //! Impulse joints cost O(joints) a step.
 
 use super::anthropometry::{Inertial, bone_radius_m, inertials, torque_limit_nm};
-use super::targets::{JointTarget, clamp, motorized};
+use super::targets::{JointTarget, motorized};
 use crate::mocap::body::{Body, JOINTS, Joint, Kind};
 use crate::mocap::math::hinge_angle;
 use crate::mocap::pose::{BodyFrame, Pose};
@@ -119,8 +119,8 @@ const BALL_AXES: &[JointAxis] = &[JointAxis::AngX, JointAxis::AngY, JointAxis::A
 
 /// The simulated humanoid and its world.
 pub struct Humanoid {
-    world: PhysicsWorld,
-    links: [RigidBodyHandle; JOINTS],
+    pub(super) world: PhysicsWorld,
+    pub(super) links: [RigidBodyHandle; JOINTS],
     colliders: [ColliderHandle; JOINTS],
     /// The ground's collider, on a free base.
     ground: Option<ColliderHandle>,
@@ -128,13 +128,13 @@ pub struct Humanoid {
     /// Per joint, the most torque each of its motors may apply, N·m (0 for
     /// the pelvis, which has none).
     torque_limits: [f64; JOINTS],
-    inertials: [Inertial; JOINTS],
+    pub(super) inertials: [Inertial; JOINTS],
     /// For each joint, the joints whose links it carries (itself included).
     carried: [Vec<Joint>; JOINTS],
     /// Each joint's place in its parent's frame.
     offsets: [DVec3; JOINTS],
-    /// The middle of each foot's sole (left, right) in its ankle's frame.
-    soles: [DVec3; 2],
+    /// The corners of each foot's sole (left, right) in its ankle's frame.
+    pub(super) soles: [[DVec3; 4]; 2],
 }
 
 /// Stiffness and damping of every motor per unit of the inertia it turns.
@@ -153,13 +153,11 @@ impl Gains {
 
 const GROUND: Group = Group::GROUP_2;
 const BODY: Group = Group::GROUP_1;
-const GRAVITY_M_S2: f64 = 9.81;
-/// The most the balance may tilt the body on its ankles.
-const BALANCE_MAX_RAD: f64 = 0.25;
+pub(super) const GRAVITY_M_S2: f64 = 9.81;
 /// Every actuator's joint stays in the world it was put in.
 const JOINT: &str = "the humanoid's joints are never removed";
-const FEET: [Joint; 2] = [Joint::LeftAnkle, Joint::RightAnkle];
-const HIPS: [Joint; 2] = [Joint::LeftHip, Joint::RightHip];
+pub(super) const FEET: [Joint; 2] = [Joint::LeftAnkle, Joint::RightAnkle];
+pub(super) const HIPS: [Joint; 2] = [Joint::LeftHip, Joint::RightHip];
 
 impl Humanoid {
     /// The humanoid of `body` in `pose`, every joint turning as `start`
@@ -220,7 +218,8 @@ impl Humanoid {
         let carried = Joint::ALL.map(|j| Joint::ALL.into_iter().filter(|&c| carries(j, c)).collect());
         let offsets = Joint::ALL.map(|j| body.offset(j));
         let soles = FEET.map(|foot| match shapes[foot.index()] {
-            Shape::Box { center, half } => center - DVec3::Y * half.y,
+            Shape::Box { center, half } => [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .map(|(x, z)| center + DVec3::new(x * half.x, -half.y, z * half.z)),
             Shape::Capsule { .. } => unreachable!("the feet are boxes"),
         });
         let mut humanoid =
@@ -252,7 +251,7 @@ impl Humanoid {
         }
     }
 
-    fn rotation(&self, j: Joint) -> DQuat {
+    pub(super) fn rotation(&self, j: Joint) -> DQuat {
         to_f64(*self.world.bodies[self.links[j.index()]].rotation())
     }
 
@@ -310,62 +309,6 @@ impl Humanoid {
         self.world.step();
     }
 
-    /// Turns the standing legs' `targets` so that the body shifts over its
-    /// standing feet to bring its centre of mass back over them. The
-    /// correction moves the capture point (the centre of mass ahead by its
-    /// velocity over the inverted pendulum's frequency, √(g/h)) onto the
-    /// middle of the soles touching the ground, up to `BALANCE_MAX_RAD` of
-    /// tilt. Each standing leg tilts about its ankle by the same turn in
-    /// the world and its hip turns back by it, so the legs move as a
-    /// parallelogram: the pelvis and all above it shift without turning.
-    /// Tilting the whole body about the feet instead (the ankle strategy
-    /// alone) cannot shift it sideways while both feet stand, as turning
-    /// about one ankle's forward axis lifts the other foot (measured: 1 of
-    /// 23 real captures stayed up that way, falling sideways with the
-    /// ankles at their tilt limit). Nothing changes while no foot stands.
-    pub fn balance(&self, targets: &mut [JointTarget; JOINTS]) {
-        let standing: Vec<usize> = (0..2).filter(|&k| self.stands(FEET[k])).collect();
-        if standing.is_empty() {
-            return;
-        }
-        let support = standing
-            .iter()
-            .map(|&k| {
-                let ankle = &self.world.bodies[self.links[FEET[k].index()]];
-                ankle.translation().as_dvec3() + to_f64(*ankle.rotation()) * self.soles[k]
-            })
-            .sum::<DVec3>()
-            / standing.len() as f64;
-        let (mut mass, mut moment, mut momentum) = (0.0, DVec3::ZERO, DVec3::ZERO);
-        for j in Joint::ALL {
-            let rigid = &self.world.bodies[self.links[j.index()]];
-            let m = self.inertials[j.index()].mass_kg;
-            mass += m;
-            moment += m * rigid.center_of_mass().as_dvec3();
-            momentum += m * rigid.linvel().as_dvec3();
-        }
-        let (com, velocity) = (moment / mass, momentum / mass);
-        let height = (com.y - support.y).max(0.1);
-        let capture = com + velocity / (GRAVITY_M_S2 / height).sqrt();
-        let shift = DVec3::new(support.x - capture.x, 0.0, support.z - capture.z);
-        // Turning a leg by θ about its ankle moves its hip, h above it, by
-        // θ × h·Y; θ = Y × shift / h moves the pelvis by `shift`.
-        let pelvis = self.rotation(Joint::Pelvis);
-        let hip_height =
-            (self.world.bodies[self.links[Joint::Pelvis.index()]].translation().as_dvec3().y - support.y).max(0.1);
-        let turn = DQuat::from_scaled_axis((DVec3::Y.cross(shift) / hip_height).clamp_length_max(BALANCE_MAX_RAD));
-        for k in standing {
-            let (foot, hip) = (FEET[k], HIPS[k]);
-            let shank = self.rotation(foot.parent().expect("only the pelvis has no parent"));
-            // The shank turned by `turn` in the world over a foot that stays,
-            let ankle = &mut targets[foot.index()];
-            ankle.rotation = clamp(foot, shank.inverse() * turn.inverse() * shank * ankle.rotation).0;
-            // and the thigh with it under a pelvis that stays.
-            let thigh = &mut targets[hip.index()];
-            thigh.rotation = clamp(hip, pelvis.inverse() * turn * pelvis * thigh.rotation).0;
-        }
-    }
-
     /// The inertia tensor (world axes, about the joint) of what each
     /// joint's motors turn: the links it carries, or, on a leg whose foot
     /// stands on the ground, the rest of the body, which that leg holds up.
@@ -392,9 +335,14 @@ impl Humanoid {
     }
 
     /// Whether `foot`'s link touches the ground.
-    fn stands(&self, foot: Joint) -> bool {
+    pub(super) fn stands(&self, foot: Joint) -> bool {
+        self.touches_ground(foot)
+    }
+
+    /// Whether joint `j`'s link touches the ground.
+    pub fn touches_ground(&self, j: Joint) -> bool {
         self.ground.is_some_and(|ground| {
-            let pair = self.world.narrow_phase.contact_pair(self.colliders[foot.index()], ground);
+            let pair = self.world.narrow_phase.contact_pair(self.colliders[j.index()], ground);
             pair.is_some_and(|p| p.has_any_active_contact())
         })
     }
@@ -517,7 +465,7 @@ fn groups(member: Group) -> InteractionGroups {
     InteractionGroups::new(member, other, InteractionTestMode::And)
 }
 
-fn to_f64(q: Quat) -> DQuat {
+pub(super) fn to_f64(q: Quat) -> DQuat {
     q.as_dquat().normalize()
 }
 

@@ -48,7 +48,10 @@ fn table(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     let text = fs::read_to_string(dir.join("execution.csv")).unwrap();
     let mut lines = text.lines();
     let header = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    // An empty cell (a margin without a standing foot) reads as NaN.
+    let rows = lines
+        .map(|l| l.split(',').map(|v| if v.is_empty() { f64::NAN } else { v.parse().unwrap() }).collect())
+        .collect();
     (header, rows)
 }
 
@@ -168,6 +171,14 @@ fn standing_on_the_ground_a_waving_humanoid_stays_up_and_one_bent_double_falls_a
     assert_eq!(s["fell"], false, "{s}");
     assert!(s["fell_at_s"].is_null());
     assert!(number(&s, "rms_error_deg") <= 3.0, "{s}");
+    // Every frame says how far the capture point lay inside the feet and
+    // how far the balance turned the targets; the summary gathers them.
+    let (header, rows) = table(&dir.path().join("up"));
+    let (margin, departure) = (column(&header, "balance_margin_m"), column(&header, "departure_deg"));
+    let least = rows[1..].iter().map(|r| r[margin]).fold(f64::INFINITY, f64::min);
+    assert!(least > 0.0 && (least - number(&s, "min_balance_margin_m")).abs() < 1e-6, "{least} against {s}");
+    let most = rows[1..].iter().map(|r| r[departure]).fold(0.0, f64::max);
+    assert!(most > 0.0 && (most - number(&s, "departure_max_deg")).abs() < 1e-3, "{most} against {s}");
 
     // Bent forward 80° at the hips within a second: the centre of mass far
     // beyond the toes.
@@ -185,6 +196,8 @@ fn standing_on_the_ground_a_waving_humanoid_stays_up_and_one_bent_double_falls_a
     let (header, rows) = table(&run);
     let last = rows.last().unwrap()[column(&header, "root_y")];
     assert!(last < 0.7 * Body::standard().pelvis_height(), "the pelvis ends at {last} m");
+    // Before it fell the capture point had left the feet.
+    assert!(number(&s, "min_balance_margin_m") < 0.0, "{s}");
 }
 
 #[test]
@@ -259,7 +272,11 @@ fn every_real_capture_plays_on_a_fixed_base_within_five_degrees_and_bind_poses_a
             assert_eq!(kept["frames"].as_u64(), s["frames"].as_u64().map(|n| n + 1), "{name}");
         }
         let rms = number(&s, "rms_error_deg");
-        eprintln!("{name:22} skipped {}: {rms:.2}° RMS, {:.1}° at worst", u8::from(left_out), number(&s, "max_error_deg"));
+        eprintln!(
+            "{name:22} skipped {}: {rms:.2}° RMS, {:.1}° at worst",
+            u8::from(left_out),
+            number(&s, "max_error_deg")
+        );
         assert!(rms <= 5.0, "{name}: {rms:.2}° RMS");
         errors.push(rms);
     }

@@ -1,0 +1,195 @@
+//! Standing balance: where the humanoid's weight is against what holds it
+//! up (the support polygon, the capture point, the margin between them),
+//! and the controller that turns the standing legs to keep the one over
+//! the other.
+
+use super::humanoid::{FEET, GRAVITY_M_S2, HIPS, Humanoid, to_f64};
+use super::targets::{JointTarget, clamp};
+use crate::mocap::body::{JOINTS, Joint};
+use glam::{DQuat, DVec2, DVec3};
+
+/// The most the balance may tilt a standing leg about its ankle.
+const BALANCE_MAX_RAD: f64 = 0.25;
+/// A sole corner this close to the ground, on a foot that touches it,
+/// bears weight (rapier's soft contacts let a loaded sole sink ~4 mm).
+const CONTACT_M: f64 = 0.02;
+
+/// Where the body's weight is against what holds it up, at one instant.
+/// Points on the ground are (x, z).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BalanceState {
+    pub com: DVec3,
+    pub velocity: DVec3,
+    /// The capture point: the centre of mass ahead by its velocity over the
+    /// inverted pendulum's frequency √(g/h), where the body comes to rest
+    /// over if it does not step.
+    pub capture: DVec2,
+    /// The support polygon: the convex hull of the sole corners on the
+    /// ground; empty while no foot stands.
+    pub support: Vec<DVec2>,
+    /// The middle of the standing soles, in the world; `None` while no
+    /// foot stands.
+    pub stance_centre: Option<DVec3>,
+}
+
+impl BalanceState {
+    /// How far the capture point lies inside the support polygon, m: its
+    /// distance to the nearest edge, negative outside (against a polygon
+    /// without area, a foot on an edge, it is never positive). `None`
+    /// while no foot stands.
+    pub fn margin_m(&self) -> Option<f64> {
+        signed_distance(&self.support, self.capture)
+    }
+}
+
+impl Humanoid {
+    /// The centre of mass, its velocity, the capture point and the support
+    /// polygon now.
+    pub fn balance_state(&self) -> BalanceState {
+        let (mut mass, mut moment, mut momentum) = (0.0, DVec3::ZERO, DVec3::ZERO);
+        for j in Joint::ALL {
+            let rigid = &self.world.bodies[self.links[j.index()]];
+            let m = self.inertials[j.index()].mass_kg;
+            mass += m;
+            moment += m * rigid.center_of_mass().as_dvec3();
+            momentum += m * rigid.linvel().as_dvec3();
+        }
+        let (com, velocity) = (moment / mass, momentum / mass);
+        let mut corners = Vec::with_capacity(8);
+        let mut middles = Vec::with_capacity(2);
+        for (k, foot) in FEET.into_iter().enumerate() {
+            if !self.stands(foot) {
+                continue;
+            }
+            let ankle = &self.world.bodies[self.links[foot.index()]];
+            let (at, turn) = (ankle.translation().as_dvec3(), to_f64(*ankle.rotation()));
+            let sole = self.soles[k].map(|c| at + turn * c);
+            middles.push(sole.iter().sum::<DVec3>() / 4.0);
+            corners.extend(sole.iter().filter(|c| c.y < CONTACT_M).map(|c| DVec2::new(c.x, c.z)));
+        }
+        let stance_centre = (!middles.is_empty()).then(|| middles.iter().sum::<DVec3>() / middles.len() as f64);
+        let ground = stance_centre.map_or(0.0, |c| c.y);
+        let height = (com.y - ground).max(0.1);
+        let ahead = com + velocity / (GRAVITY_M_S2 / height).sqrt();
+        BalanceState {
+            com,
+            velocity,
+            capture: DVec2::new(ahead.x, ahead.z),
+            support: convex_hull(corners),
+            stance_centre,
+        }
+    }
+
+    /// Turns the standing legs' `targets` so that the body shifts over its
+    /// standing feet to bring its centre of mass back over them. The
+    /// correction moves the capture point onto the middle of the standing
+    /// soles, up to `BALANCE_MAX_RAD` of tilt. Each standing leg tilts
+    /// about its ankle by the same turn in the world and its hip turns back
+    /// by it, so the legs move as a parallelogram: the pelvis and all above
+    /// it shift without turning. Tilting the whole body about the feet
+    /// instead (the ankle strategy alone) cannot shift it sideways while
+    /// both feet stand, as turning about one ankle's forward axis lifts the
+    /// other foot (measured: 1 of 23 real captures stayed up that way,
+    /// falling sideways with the ankles at their tilt limit). Nothing
+    /// changes while no foot stands.
+    pub fn balance(&self, targets: &mut [JointTarget; JOINTS]) {
+        let state = self.balance_state();
+        let Some(support) = state.stance_centre else { return };
+        let shift = DVec3::new(support.x - state.capture.x, 0.0, support.z - state.capture.y);
+        // Turning a leg by θ about its ankle moves its hip, h above it, by
+        // θ × h·Y; θ = Y × shift / h moves the pelvis by `shift`.
+        let pelvis = self.rotation(Joint::Pelvis);
+        let hip_height =
+            (self.world.bodies[self.links[Joint::Pelvis.index()]].translation().as_dvec3().y - support.y).max(0.1);
+        let turn = DQuat::from_scaled_axis((DVec3::Y.cross(shift) / hip_height).clamp_length_max(BALANCE_MAX_RAD));
+        for k in (0..2).filter(|&k| self.stands(FEET[k])) {
+            let (foot, hip) = (FEET[k], HIPS[k]);
+            let shank = self.rotation(foot.parent().expect("only the pelvis has no parent"));
+            // The shank turned by `turn` in the world over a foot that stays,
+            let ankle = &mut targets[foot.index()];
+            ankle.rotation = clamp(foot, shank.inverse() * turn.inverse() * shank * ankle.rotation).0;
+            // and the thigh with it under a pelvis that stays.
+            let thigh = &mut targets[hip.index()];
+            thigh.rotation = clamp(hip, pelvis.inverse() * turn * pelvis * thigh.rotation).0;
+        }
+    }
+}
+
+/// The convex hull of `points`, each edge turning left to the next (a
+/// positive perp_dot, the orientation [`signed_distance`] expects), without
+/// repeated or collinear points (Andrew's monotone chain).
+fn convex_hull(mut points: Vec<DVec2>) -> Vec<DVec2> {
+    points.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    points.dedup();
+    if points.len() < 3 {
+        return points;
+    }
+    let turns_left = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o) > 0.0;
+    let mut hull: Vec<DVec2> = Vec::with_capacity(points.len() + 1);
+    for pass in [&points[..], &points.iter().rev().copied().collect::<Vec<_>>()[..]] {
+        let floor = hull.len();
+        for &p in pass {
+            while hull.len() >= floor + 2 && !turns_left(hull[hull.len() - 2], hull[hull.len() - 1], p) {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        // Each pass's last point starts the other.
+        hull.pop();
+    }
+    hull
+}
+
+/// The distance from `p` to the nearest edge of the convex polygon `hull`
+/// (as [`convex_hull`] orders it), positive inside, negative outside;
+/// `None` for no polygon.
+fn signed_distance(hull: &[DVec2], p: DVec2) -> Option<f64> {
+    let to_segment = |a: DVec2, b: DVec2| {
+        let along = b - a;
+        let t = if along.length_squared() > 0.0 {
+            ((p - a).dot(along) / along.length_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (a + t * along).distance(p)
+    };
+    match hull.len() {
+        0 => None,
+        1 => Some(-hull[0].distance(p)),
+        2 => Some(-to_segment(hull[0], hull[1])),
+        n => {
+            let edges = (0..n).map(|i| (hull[i], hull[(i + 1) % n]));
+            let inside = edges.clone().all(|(a, b)| (b - a).perp_dot(p - a) >= 0.0);
+            let nearest = edges.map(|(a, b)| to_segment(a, b)).fold(f64::INFINITY, f64::min);
+            Some(if inside { nearest } else { -nearest })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_margin_is_the_distance_to_the_nearest_edge_inside_and_negative_outside() {
+        // Two feet side by side, corners in any order, one repeated, one
+        // on an edge.
+        let corners = [(0.0, 0.0), (0.1, 0.0), (0.1, 0.2), (0.0, 0.2), (0.3, 0.0), (0.4, 0.0), (0.4, 0.2), (0.3, 0.2)]
+            .map(|(x, z)| DVec2::new(x, z));
+        let mut points = corners.to_vec();
+        points.extend([corners[2], DVec2::new(0.2, 0.0)]);
+        points.reverse();
+        let hull = convex_hull(points);
+        assert_eq!(hull.len(), 4, "{hull:?}");
+        let close = |got: Option<f64>, want: f64| (got.unwrap() - want).abs() < 1e-12;
+        assert!(close(signed_distance(&hull, DVec2::new(0.2, 0.1)), 0.1));
+        assert!(close(signed_distance(&hull, DVec2::new(0.2, 0.05)), 0.05));
+        assert!(close(signed_distance(&hull, DVec2::new(0.2, 0.5)), -0.3));
+        assert!(close(signed_distance(&hull, DVec2::new(0.7, 0.6)), -0.5));
+        // One foot on its edge: a segment, never positive.
+        let edge = convex_hull(vec![DVec2::ZERO, DVec2::new(0.0, 0.2)]);
+        assert!(close(signed_distance(&edge, DVec2::new(0.0, 0.1)), 0.0));
+        assert!(close(signed_distance(&edge, DVec2::new(0.1, 0.1)), -0.1));
+        assert_eq!(signed_distance(&[], DVec2::ZERO), None);
+    }
+}
