@@ -158,6 +158,7 @@ def execute(
     gains: Tuple[float, float] = (10000.0, 200.0),
     rate: float = 240.0,
     skip: Optional[int] = None,
+    assist: bool = False,
     up: Optional[str] = None,
     mapping: Optional[PathLike] = None,
 ) -> Any:
@@ -170,13 +171,16 @@ def execute(
     ankles to the trajectory; ``gains`` are the motors' stiffness and
     damping (KP 1/s², KD 1/s); ``rate`` the physics steps a second;
     ``skip`` leaves out the first frames (by default the first one when it
-    is a bind pose, as ``imitate execute`` does; ``skip=0`` keeps it). With
+    is a bind pose, as ``imitate execute`` does; ``skip=0`` keeps it);
+    ``assist`` pulls the pelvis toward the trajectory's with a residual
+    force and torque, reported in the table (``assist_force_n``,
+    ``assist_torque_nm``). With
     ``out``, the execution's folder (executed.bvh, execution.csv,
     summary.json) is written there too; a folder that holds something is
     refused unless ``force``."""
     _check_frame(frame)
     if not isinstance(motion, Motion):
         motion = read_bvh(motion, up, mapping)
-    text = _imitate.execute_table(motion, out, force, fixed_base, balance, tuple(gains), rate, skip)
+    text = _imitate.execute_table(motion, out, force, fixed_base, balance, tuple(gains), rate, skip, assist)
     return _table(text, frame)
 

@@ -203,4 +203,5 @@ def execute_table(
     gains: Tuple[float, float] = (10000.0, 200.0),
     rate: float = 240.0,
     skip: Optional[int] = None,
+    assist: bool = False,
 ) -> str: ...

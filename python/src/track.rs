@@ -672,7 +672,7 @@ pub fn score_run(py: Python<'_>, run: PathBuf, truth: PathBuf, settle: f64) -> P
 /// and returns ``execution.csv``'s text, writing the execution's folder
 /// to `out` when given.
 #[pyfunction]
-#[pyo3(signature = (motion, out=None, force=false, fixed_base=false, balance=true, gains=(10000.0, 200.0), rate=240.0, skip=None))]
+#[pyo3(signature = (motion, out=None, force=false, fixed_base=false, balance=true, gains=(10000.0, 200.0), rate=240.0, skip=None, assist=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn execute_table(
     py: Python<'_>,
@@ -684,10 +684,11 @@ pub fn execute_table(
     gains: (f64, f64),
     rate: f64,
     skip: Option<usize>,
+    assist: bool,
 ) -> PyResult<String> {
     let base = if fixed_base { Base::Fixed } else { Base::Free };
     let gains = Gains { kp_per_s2: gains.0, kd_per_s: gains.1 };
-    let params = ExecuteParams { base, balance, gains, rate_hz: rate }.check().map_err(|e| {
+    let params = ExecuteParams { base, balance, assist, gains, rate_hz: rate }.check().map_err(|e| {
         let keyword = if e.field() == "rate_hz" { "rate" } else { e.field() };
         raise(Class::Options, e.naming(keyword), None)
     })?;

@@ -134,6 +134,15 @@ def test_execute_returns_the_cli_execution_table_and_writes_its_folder(tmp_path,
         imitate.execute("mocap/punch.bvh", out=tmp_path / "mine", fixed_base=True)
 
 
+def test_execute_with_assistance_matches_the_cli_and_refuses_a_fixed_base(tmp_path, cli):
+    cli("execute", "mocap/punch.bvh", "-o", tmp_path / "run", "--assist")
+    table = imitate.execute("mocap/punch.bvh", assist=True)
+    pd.testing.assert_frame_equal(table, read_csv(tmp_path / "run" / "execution.csv"))
+    assert (table["assist_force_n"] > 0).any()
+    with pytest.raises(imitate.OptionsError, match="assist: assistance holds a humanoid up on the ground"):
+        imitate.execute("mocap/punch.bvh", assist=True, fixed_base=True)
+
+
 def test_bad_inputs_name_the_file(tmp_path, cli, clip):
     with pytest.raises(imitate.VideoError) as caught:
         imitate.track(tmp_path / "none", "vocab/default.vocab")

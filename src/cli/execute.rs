@@ -36,6 +36,11 @@ pub struct Args {
     /// mass over the feet).
     #[arg(long)]
     pub no_balance: bool,
+    /// On a free base, pull the pelvis toward the trajectory's with a
+    /// residual force and torque where the joints cannot follow it (walks,
+    /// jumps): written per frame and summarized, never hidden.
+    #[arg(long)]
+    pub assist: bool,
     /// Motor stiffness and damping per unit of the inertia each joint
     /// turns, KP (1/s²) and KD (1/s): √KP is the joints' natural frequency
     /// (rad/s), KD / (2√KP) their damping ratio.
@@ -67,16 +72,22 @@ fn parse_gains(text: &str) -> Result<Gains, UsageError> {
 
 pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let base = if args.fixed_base { Base::Fixed } else { Base::Free };
-    let params =
-        ExecuteParams { base, balance: !args.no_balance, gains: parse_gains(&args.gains)?, rate_hz: args.rate }
-            .check()
-            .map_err(|e| {
-                let flag = match e {
-                    ExecuteParamsError::Kp(_) | ExecuteParamsError::Kd(_) => format!("--gains {}", args.gains),
-                    ExecuteParamsError::Rate(_) => format!("--rate {}", args.rate),
-                };
-                UsageError(e.naming(&flag))
-            })?;
+    let params = ExecuteParams {
+        base,
+        balance: !args.no_balance,
+        assist: args.assist,
+        gains: parse_gains(&args.gains)?,
+        rate_hz: args.rate,
+    }
+    .check()
+    .map_err(|e| {
+        let flag = match e {
+            ExecuteParamsError::Kp(_) | ExecuteParamsError::Kd(_) => format!("--gains {}", args.gains),
+            ExecuteParamsError::Rate(_) => format!("--rate {}", args.rate),
+            ExecuteParamsError::AssistFixed => "--assist with --fixed-base".to_string(),
+        };
+        UsageError(e.naming(&flag))
+    })?;
     refuse_nonempty(&args.output, args.force)?;
     let (mut motion, _) = take(&args.input, None, &args.retarget, global)?;
     let input = args.input.display().to_string();
@@ -102,10 +113,18 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         None if base == Base::Free => ", stayed up".to_string(),
         None => String::new(),
     };
+    let assisted = summary.assist.as_ref().map_or(String::new(), |a| {
+        format!(
+            " with assistance of {:.0} N on average ({:.1}% of its weight), {:.0} N at most",
+            a.mean_force_n,
+            100.0 * a.mean_force_share_of_weight,
+            a.max_force_n
+        )
+    });
     note(
         global,
         &format!(
-            "{input}: {} frames, {:.2} s at {:.0} Hz ({} base): joint error {:.2}° RMS, {:.2}° at worst{fell} → {output}\n\
+            "{input}: {} frames, {:.2} s at {:.0} Hz ({} base): joint error {:.2}° RMS, {:.2}° at worst{fell}{assisted} → {output}\n\
              simulated {:.2} s in {seconds:.3} s on one core ({:.0}× real time, {:.1} µs a step)",
             summary.frames,
             summary.duration_s,

@@ -3,7 +3,8 @@
 //! what was asked, what the humanoid did and what it cost.
 
 use super::anthropometry::body_mass_kg;
-use super::humanoid::{Base, Gains, Humanoid};
+use super::assist::Wrench;
+use super::humanoid::{Base, GRAVITY_M_S2, Gains, Humanoid};
 use super::targets::{JointTarget, Targets, TargetsError, motorized};
 use crate::fsutil::{WriteError, round6, rounded, rounded_option, write_atomic, write_dir_atomic};
 use crate::mocap::body::{JOINTS, Joint, Kind};
@@ -23,6 +24,9 @@ pub struct ExecuteParams {
     /// On a free base, turn the ankles' targets to keep the centre of mass
     /// over the feet ([`Humanoid::balance`]).
     pub balance: bool,
+    /// On a free base, pull the pelvis toward the trajectory's with a
+    /// residual force and torque ([`Humanoid::assist`]), reported.
+    pub assist: bool,
     pub gains: Gains,
     /// Physics steps a second; rounded up to a whole number of steps per
     /// frame of the trajectory.
@@ -31,7 +35,7 @@ pub struct ExecuteParams {
 
 impl Default for ExecuteParams {
     fn default() -> Self {
-        ExecuteParams { base: Base::Free, balance: true, gains: Gains::STANDARD, rate_hz: 240.0 }
+        ExecuteParams { base: Base::Free, balance: true, assist: false, gains: Gains::STANDARD, rate_hz: 240.0 }
     }
 }
 
@@ -47,6 +51,8 @@ pub enum ExecuteParamsError {
     Kd(f64),
     #[error("rate_hz: the physics rate must be a number of steps a second in (0, {max}], not {0}", max = ExecuteParams::MAX_RATE_HZ)]
     Rate(f64),
+    #[error("assist: assistance holds a humanoid up on the ground; a fixed base needs none")]
+    AssistFixed,
 }
 
 impl InvalidField for ExecuteParamsError {
@@ -54,6 +60,7 @@ impl InvalidField for ExecuteParamsError {
         match self {
             ExecuteParamsError::Kp(_) | ExecuteParamsError::Kd(_) => "gains",
             ExecuteParamsError::Rate(_) => "rate_hz",
+            ExecuteParamsError::AssistFixed => "assist",
         }
     }
 }
@@ -77,6 +84,9 @@ impl Params for ExecuteParams {
         }
         if !(self.rate_hz.is_finite() && self.rate_hz > 0.0 && self.rate_hz <= Self::MAX_RATE_HZ) {
             return Err(ExecuteParamsError::Rate(self.rate_hz));
+        }
+        if self.assist && self.base == Base::Fixed {
+            return Err(ExecuteParamsError::AssistFixed);
         }
         Ok(ValidExecuteParams(*self))
     }
@@ -104,6 +114,9 @@ pub struct ExecutedFrame {
     /// The most the balance turned a joint's target away from the
     /// trajectory's in the step that ended here, radians.
     pub departure_rad: f64,
+    /// The assistance on the pelvis in the step that ended here (zero
+    /// without `assist`).
+    pub assist: Wrench,
 }
 
 /// A trajectory played on the humanoid.
@@ -164,9 +177,27 @@ pub struct Summary {
     pub departure_rms_deg: f64,
     #[serde(serialize_with = "rounded")]
     pub departure_max_deg: f64,
+    /// The assistance's size over every step: `None` without it.
+    pub assist: Option<AssistSummary>,
     pub fell: bool,
     pub fell_at_s: Option<f64>,
     pub joints: Vec<JointSummary>,
+}
+
+/// How hard the assistance pulled, over every physics step.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct AssistSummary {
+    #[serde(serialize_with = "rounded")]
+    pub mean_force_n: f64,
+    #[serde(serialize_with = "rounded")]
+    pub max_force_n: f64,
+    /// The mean force as a share of the body's weight.
+    #[serde(serialize_with = "rounded")]
+    pub mean_force_share_of_weight: f64,
+    #[serde(serialize_with = "rounded")]
+    pub mean_torque_nm: f64,
+    #[serde(serialize_with = "rounded")]
+    pub max_torque_nm: f64,
 }
 
 /// One actuated joint's numbers.
@@ -207,7 +238,7 @@ pub fn execute(
     params: &ValidExecuteParams,
     mut progress: impl FnMut(),
 ) -> Result<Execution, TargetsError> {
-    let ExecuteParams { base, balance, gains, rate_hz } = params.0;
+    let ExecuteParams { base, balance, assist, gains, rate_hz } = params.0;
     let balance = balance && base == Base::Free;
     let (levelled, feet_levelled_rad) = match base {
         Base::Free => level_feet(motion),
@@ -230,25 +261,25 @@ pub fn execute(
     let asked_leans: Vec<f64> = (0..targets.frames()).map(|k| lean(&motion.body.forward(targets.pose(k)))).collect();
 
     let mut frames = Vec::with_capacity(targets.frames());
-    let mut record = |k: usize, humanoid: &Humanoid, torque: [DVec3; JOINTS], departure_rad: f64| {
+    // Where the humanoid's pelvis was put against the trajectory's.
+    let offset = humanoid.frame().position(Joint::Pelvis) - targets.pose(0).root;
+    if assist {
+        humanoid.attach_assist();
+    }
+    let (mut force_sum, mut torque_sum, mut force_max, mut torque_max) = (0.0, 0.0, 0.0f64, 0.0f64);
+    let mut record = |k: usize, humanoid: &Humanoid, torque: [DVec3; JOINTS], departure_rad: f64, assist: Wrench| {
         let achieved = humanoid.pose();
         let asked = targets.pose(k);
         let mut error_rad = Joint::ALL.map(|j| angle_between(asked.local_rotation(j), achieved.local_rotation(j)));
         error_rad[Joint::Pelvis.index()] = angle_between(asked.tilt(), achieved.tilt());
         let margin_m = (base == Base::Free).then(|| humanoid.balance_state().margin_m()).flatten();
-        frames.push(ExecutedFrame {
-            time_s: k as f64 * frame_time,
-            achieved,
-            torque,
-            error_rad,
-            margin_m,
-            departure_rad,
-        });
+        let time_s = k as f64 * frame_time;
+        frames.push(ExecutedFrame { time_s, achieved, torque, error_rad, margin_m, departure_rad, assist });
     };
-    record(0, &humanoid, torque, 0.0);
+    record(0, &humanoid, torque, 0.0, Wrench::default());
     progress();
     for k in 1..targets.frames() {
-        let mut departure_rad = 0.0;
+        let (mut departure_rad, mut wrench) = (0.0, Wrench::default());
         for s in 1..=steps_per_frame {
             let time_s = (k - 1) as f64 * frame_time + s as f64 * dt;
             targets.sample(time_s, &mut asked);
@@ -259,7 +290,17 @@ pub fn execute(
                     .map(|j| angle_between(wanted[j.index()].rotation, asked[j.index()].rotation))
                     .fold(0.0, f64::max);
             }
+            if assist {
+                humanoid.assist_toward(&targets.root_at(time_s), offset);
+            }
             humanoid.step(&asked, gains);
+            if assist {
+                wrench = humanoid.assist_wrench();
+                force_sum += wrench.force.length();
+                torque_sum += wrench.torque.length();
+                force_max = force_max.max(wrench.force.length());
+                torque_max = torque_max.max(wrench.torque.length());
+            }
             humanoid.torques(&mut torque, &mut at_limit);
             for j in motorized() {
                 peak[j.index()] = peak[j.index()].max(torque[j.index()].length());
@@ -269,7 +310,7 @@ pub fn execute(
                 fell_at_s = Some(time_s);
             }
         }
-        record(k, &humanoid, torque, departure_rad);
+        record(k, &humanoid, torque, departure_rad, wrench);
         max_joint_gap_m = max_joint_gap_m.max(humanoid.largest_joint_gap_m());
         progress();
     }
@@ -320,6 +361,17 @@ pub fn execute(
             .min_by(f64::total_cmp),
         departure_rms_deg: rms_deg(&mut scored.iter().map(|f| f.departure_rad)),
         departure_max_deg: max_deg(&mut scored.iter().map(|f| f.departure_rad)),
+        assist: assist.then(|| {
+            let mass = body_mass_kg(&motion.body);
+            let mean_force_n = force_sum / steps.max(1) as f64;
+            AssistSummary {
+                mean_force_n,
+                max_force_n: force_max,
+                mean_force_share_of_weight: mean_force_n / (mass * GRAVITY_M_S2),
+                mean_torque_nm: torque_sum / steps.max(1) as f64,
+                max_torque_nm: torque_max,
+            }
+        }),
         fell: fell_at_s.is_some(),
         fell_at_s,
         joints,
@@ -502,7 +554,7 @@ impl Execution {
             }
             columns.push(format!("{}_error_deg", j.name()));
         }
-        columns.extend(["balance_margin_m", "departure_deg"].map(String::from));
+        columns.extend(["balance_margin_m", "departure_deg", "assist_force_n", "assist_torque_nm"].map(String::from));
         columns.join(",") + "\n"
     }
 
@@ -534,7 +586,8 @@ impl Execution {
             write!(line, ",{:.4}", f.error_rad[j.index()].to_degrees()).expect(INFALLIBLE);
         }
         let margin = f.margin_m.map_or(String::new(), |m| format!("{m:.6}"));
-        write!(line, ",{margin},{:.4}", f.departure_rad.to_degrees()).expect(INFALLIBLE);
+        let (force, twist) = (f.assist.force.length(), f.assist.torque.length());
+        write!(line, ",{margin},{:.4},{force:.3},{twist:.3}", f.departure_rad.to_degrees()).expect(INFALLIBLE);
         line + "\n"
     }
 }

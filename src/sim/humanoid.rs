@@ -135,6 +135,9 @@ pub struct Humanoid {
     offsets: [DVec3; JOINTS],
     /// The corners of each foot's sole (left, right) in its ankle's frame.
     pub(super) soles: [[DVec3; 4]; 2],
+    /// With assistance, the body that carries the trajectory's pelvis and
+    /// the spring joint from it to the pelvis ([`super::assist`]).
+    pub(super) anchor: Option<(RigidBodyHandle, ImpulseJointHandle)>,
 }
 
 /// Stiffness and damping of every motor per unit of the inertia it turns.
@@ -222,8 +225,19 @@ impl Humanoid {
                 .map(|(x, z)| center + DVec3::new(x * half.x, -half.y, z * half.z)),
             Shape::Capsule { .. } => unreachable!("the feet are boxes"),
         });
-        let mut humanoid =
-            Humanoid { world, links, colliders, ground, actuators, torque_limits, inertials, carried, offsets, soles };
+        let mut humanoid = Humanoid {
+            world,
+            links,
+            colliders,
+            ground,
+            actuators,
+            torque_limits,
+            inertials,
+            carried,
+            offsets,
+            soles,
+            anchor: None,
+        };
         humanoid.set_velocities(start);
         humanoid
     }
@@ -257,7 +271,7 @@ impl Humanoid {
 
     /// The length of rapier's substeps: it splits each step into as many as
     /// it runs solver iterations, and motor impulses are per substep.
-    fn substep_s(&self) -> f64 {
+    pub(super) fn substep_s(&self) -> f64 {
         let p = &self.world.integration_parameters;
         f64::from(p.dt) / p.num_solver_iterations as f64
     }

@@ -3,6 +3,7 @@
 //! the playing of a trajectory on it (`imitate execute`).
 
 pub mod anthropometry;
+pub mod assist;
 pub mod balance;
 pub mod execute;
 pub mod humanoid;

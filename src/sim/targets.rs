@@ -23,6 +23,15 @@ impl JointTarget {
     pub const REST: JointTarget = JointTarget { rotation: DQuat::IDENTITY, spin: DVec3::ZERO };
 }
 
+/// Where the trajectory's pelvis is at an instant ([`Targets::root_at`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RootTarget {
+    pub position: DVec3,
+    pub velocity: DVec3,
+    pub rotation: DQuat,
+    pub spin: DVec3,
+}
+
 /// A trajectory's poses as the motors take them.
 #[derive(Clone, Debug)]
 pub struct Targets {
@@ -146,6 +155,31 @@ impl Targets {
     /// Frames on which some joint lay beyond its limits.
     pub fn frames_clamped(&self) -> usize {
         self.frames_clamped
+    }
+
+    /// The trajectory's pelvis at `time_s`, between frames on the straight
+    /// line and the shortest turn: where it is, how fast it goes (m/s),
+    /// how it is turned in the world and how fast that turns (rad/s, world
+    /// axes). Beyond the last frame it holds still.
+    pub fn root_at(&self, time_s: f64) -> RootTarget {
+        let last = self.frames() - 1;
+        let at = (time_s / self.frame_time_s).max(0.0);
+        let turn = |k: usize| self.poses[k].local_rotation(Joint::Pelvis);
+        if at >= last as f64 {
+            let held = &self.poses[last];
+            return RootTarget { position: held.root, velocity: DVec3::ZERO, rotation: turn(last), spin: DVec3::ZERO };
+        }
+        let k = at.floor() as usize;
+        let u = at - k as f64;
+        let (a, b) = (&self.poses[k], &self.poses[k + 1]);
+        let (from, to) = (turn(k), turn(k + 1));
+        let step = log_map(to * from.inverse());
+        RootTarget {
+            position: a.root.lerp(b.root, u),
+            velocity: (b.root - a.root) / self.frame_time_s,
+            rotation: exp_map(u * step) * from,
+            spin: step / self.frame_time_s,
+        }
     }
 
     /// Every motorized joint's target at `time_s` (the pelvis's entry is

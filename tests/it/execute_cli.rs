@@ -198,6 +198,21 @@ fn standing_on_the_ground_a_waving_humanoid_stays_up_and_one_bent_double_falls_a
     assert!(last < 0.7 * Body::standard().pelvis_height(), "the pelvis ends at {last} m");
     // Before it fell the capture point had left the feet.
     assert!(number(&s, "min_balance_margin_m") < 0.0, "{s}");
+    assert!(s["assist"].is_null() && rows.iter().all(|r| r[column(&header, "assist_force_n")] == 0.0));
+
+    // Assisted, the same take stays up; the pull is in every frame's row
+    // and in the summary, as a share of the body's weight.
+    let run = dir.path().join("held");
+    let s = executed(&bending, &run, &["-q", "--assist"]);
+    assert_eq!(s["fell"], false, "{s}");
+    let (header, rows) = table(&run);
+    let force = column(&header, "assist_force_n");
+    let most = rows.iter().map(|r| r[force]).fold(0.0, f64::max);
+    let assist = &s["assist"];
+    assert!(most > 0.0 && most <= number(assist, "max_force_n") + 1e-3, "{most} against {assist}");
+    let weight = number(&s, "mass_kg") * 9.81;
+    let share = number(assist, "mean_force_share_of_weight");
+    assert!((share * weight - number(assist, "mean_force_n")).abs() < 1e-3 && share > 0.0, "{assist}");
 }
 
 #[test]
@@ -307,7 +322,7 @@ fn bad_input_is_one_clear_error_and_writes_nothing() {
     fs::write(used.join("keep.txt"), "mine").unwrap();
 
     let out = dir.path().join("out");
-    let cases: [(&Path, &Path, &[&str], i32, &str); 11] = [
+    let cases: [(&Path, &Path, &[&str], i32, &str); 12] = [
         (&good, &out, &["--gains", "0,200"], 2, "--gains 0,200: the stiffness gain must be a positive number"),
         (&good, &out, &["--gains", "-5,200"], 2, "--gains -5,200: the stiffness gain must be a positive number"),
         (&good, &out, &["--gains", "100,0"], 2, "--gains 100,0: the damping gain must be a positive number"),
@@ -315,6 +330,7 @@ fn bad_input_is_one_clear_error_and_writes_nothing() {
         (&good, &out, &["--rate", "0"], 2, "--rate 0: the physics rate must be"),
         (&good, &out, &["--rate", "-240"], 2, "--rate -240: the physics rate must be"),
         (&good, &out, &["--skip", "100000"], 2, "--skip 100000: "),
+        (&good, &out, &["--assist", "--fixed-base"], 2, "--assist with --fixed-base: assistance holds a humanoid up"),
         (&empty, &out, &[], 1, "empty.bvh: the file has no frames"),
         (&nan, &out, &[], 1, "nan.bvh:"),
         (&missing, &out, &[], 1, "missing.bvh"),

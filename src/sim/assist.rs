@@ -1,0 +1,89 @@
+//! Assistance (`execute --assist`): a residual force and torque on the
+//! pelvis that pull it toward the trajectory's, the "hand of God" of
+//! physics-based character control, for motion the humanoid's own joints
+//! cannot follow on the ground (walking without stepping, jumps). It is
+//! always reported, never hidden: its size at every frame and over the
+//! run.
+//!
+//! The pull is a six-axis spring joint from a body that carries the
+//! trajectory's pelvis (moved to it every step, and colliding with
+//! nothing) to the humanoid's pelvis. The solver treats a joint's spring
+//! implicitly; the same spring applied as an external force on the pelvis
+//! link is explicit, and its damping, scaled for the whole body and
+//! acting on the pelvis's small inertia alone, blew the humanoid apart in
+//! the first step (measured: 10⁵ N at once).
+
+use super::humanoid::Humanoid;
+use super::targets::RootTarget;
+use crate::mocap::body::Joint;
+use glam::{DQuat, DVec3};
+use rapier3d::prelude::*;
+
+/// The pull's natural frequency (rad/s), critically damped: stiff enough to
+/// hold a falling body up within a few centimetres, soft beside the
+/// joints' 100 rad/s so the joints, not the pull, make the motion.
+const ASSIST_RAD_S: f64 = 10.0;
+/// The radius of gyration (m) the torque's gains treat the whole body as
+/// turning with about its pelvis: about a standing adult's about a
+/// horizontal axis through the hips.
+const GYRATION_M: f64 = 0.5;
+const LINEAR: [JointAxis; 3] = [JointAxis::LinX, JointAxis::LinY, JointAxis::LinZ];
+const ANGULAR: [JointAxis; 3] = [JointAxis::AngX, JointAxis::AngY, JointAxis::AngZ];
+const ANCHOR: &str = "the assistance's joint is never removed";
+
+/// A force (N) and a torque (N·m) on the pelvis, world axes.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Wrench {
+    pub force: DVec3,
+    pub torque: DVec3,
+}
+
+impl Humanoid {
+    /// Attaches the assistance's spring where the pelvis is now, scaled by
+    /// the whole body's mass and its inertia about the pelvis so it moves
+    /// the body, not only the pelvis.
+    pub fn attach_assist(&mut self) {
+        let mass: f64 = self.inertials.iter().map(|i| i.mass_kg).sum();
+        let inertia = mass * GYRATION_M * GYRATION_M;
+        let (kp, kd) = (ASSIST_RAD_S * ASSIST_RAD_S, 2.0 * ASSIST_RAD_S);
+        let pelvis = self.links[Joint::Pelvis.index()];
+        let at = *self.world.bodies[pelvis].position();
+        let anchor = self.world.bodies.insert(RigidBodyBuilder::kinematic_position_based().pose(at));
+        let mut joint = GenericJointBuilder::new(JointAxesMask::empty()).build();
+        for (axes, scale) in [(LINEAR, mass), (ANGULAR, inertia)] {
+            for axis in axes {
+                joint.set_motor_model(axis, MotorModel::ForceBased);
+                joint.set_motor(axis, 0.0, 0.0, (kp * scale) as f32, (kd * scale) as f32);
+            }
+        }
+        let handle = self.world.impulse_joints.insert(anchor, pelvis, joint, true);
+        self.anchor = Some((anchor, handle));
+    }
+
+    /// Moves the spring's far end to `target` (the trajectory's pelvis,
+    /// shifted by `offset` to where the humanoid was put) by the end of
+    /// the next step.
+    pub fn assist_toward(&mut self, target: &RootTarget, offset: DVec3) {
+        let (anchor, _) = self.anchor.expect("attach_assist comes first");
+        let pose = rapier3d::math::Pose::from_parts((target.position + offset).as_vec3(), target.rotation.as_quat());
+        self.world.bodies[anchor].set_next_kinematic_position(pose);
+    }
+
+    /// The force and torque the spring applied to the pelvis in the last
+    /// substep of the last step; zero without assistance.
+    pub fn assist_wrench(&self) -> Wrench {
+        let Some((anchor, handle)) = self.anchor else { return Wrench::default() };
+        let data = &self.world.impulse_joints.get(handle).expect(ANCHOR).data;
+        let frame = self.world.bodies[anchor].rotation().as_dquat().normalize() * to_dquat(data.local_frame1.rotation);
+        let substep = self.substep_s();
+        let along = |axes: [JointAxis; 3]| {
+            let impulse = axes.map(|a| data.motor(a).map_or(0.0, |m| f64::from(m.impulse)));
+            frame * DVec3::from_array(impulse) / substep
+        };
+        Wrench { force: along(LINEAR), torque: along(ANGULAR) }
+    }
+}
+
+fn to_dquat(q: glam::Quat) -> DQuat {
+    q.as_dquat().normalize()
+}
