@@ -66,13 +66,16 @@ import json, sys
 from pathlib import Path
 
 flags = sys.argv[1]
+assisted = "--assist" in flags.split()
 lines = [f"`imitate execute {flags}`".replace(" `", "`"), "",
-         "| takes | played | stay up | RMS joint error where up (median, max) | falls (at s) |",
-         "| --- | --- | --- | --- | --- |"]
+         "| takes | played | stay up | RMS joint error where up (median, max) | "
+         + ("mean assisting force, share of body weight (median, max) | " if assisted else "")
+         + "falls (at s) |",
+         "| --- | --- | --- | --- | " + ("--- | " if assisted else "") + "--- |"]
 for group in sorted(Path("runs").iterdir()):
     if not group.is_dir():
         continue
-    played, up, errors, falls, refused = 0, 0, [], [], []
+    played, up, errors, falls, refused, shares = 0, 0, [], [], [], []
     # Every take played leaves its stderr; a refused one no folder.
     for err in sorted(group.glob("*.err")):
         run = err.with_suffix("")
@@ -82,6 +85,8 @@ for group in sorted(Path("runs").iterdir()):
             continue
         s = json.loads(summary.read_text())
         played += 1
+        if s.get("assist"):
+            shares.append(s["assist"]["mean_force_share_of_weight"])
         if s["fell"]:
             falls.append(f"{run.name} ({s['fell_at_s']:.1f})")
         else:
@@ -91,7 +96,9 @@ for group in sorted(Path("runs").iterdir()):
     where_up = f"{errors[len(errors) // 2]:.1f}°, {errors[-1]:.1f}°" if errors else "—"
     share = 100 * up / played if played else 0
     refused_note = f"; refused: {', '.join(refused)}" if refused else ""
-    lines.append(f"| {group.name} | {played} | {up} ({share:.0f}%) | {where_up} | "
+    shares.sort()
+    pull = f"{100 * shares[len(shares) // 2]:.0f}%, {100 * shares[-1]:.0f}% | " if shares else ("— | " if assisted else "")
+    lines.append(f"| {group.name} | {played} | {up} ({share:.0f}%) | {where_up} | {pull}"
                  f"{'; '.join(falls) or '—'}{refused_note} |")
 text = "\n".join(lines)
 Path("execute-trials.md").write_text(text + "\n")

@@ -63,6 +63,11 @@ pub struct Args {
     pub force: bool,
 }
 
+/// A first frame whose lowest point lies further than this from the floor
+/// is said to start in the air or under it (the real captures start within
+/// 8 cm, their skeletons' feet unlike the canonical body's).
+const OFF_THE_FLOOR_M: f64 = 0.10;
+
 /// `KP,KD`.
 fn parse_gains(text: &str) -> Result<Gains, UsageError> {
     let bad = || UsageError(format!("--gains {text}: expected KP,KD, two positive numbers, e.g. 10000,200"));
@@ -113,6 +118,18 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         None if base == Base::Free => ", stayed up".to_string(),
         None => String::new(),
     };
+    let raised = summary.start_raised_m;
+    if raised.abs() > OFF_THE_FLOOR_M {
+        let (by, where_) =
+            if raised < 0.0 { (-raised, "above the floor (in the air)") } else { (raised, "below the floor") };
+        note(
+            global,
+            &format!(
+                "{input}: warning: the first frame's lowest point lies {by:.2} m {where_}; the humanoid started \
+                 standing on it"
+            ),
+        );
+    }
     let assisted = summary.assist.as_ref().map_or(String::new(), |a| {
         format!(
             " with assistance of {:.0} N on average ({:.1}% of its weight), {:.0} N at most",

@@ -92,6 +92,19 @@ impl Params for ExecuteParams {
     }
 }
 
+/// Why a trajectory could not be played.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ExecuteError {
+    #[error(transparent)]
+    Targets(#[from] TargetsError),
+    #[error(
+        "at {time_s:.3} s the {joint} moved at {speed_m_s:.3e} m/s, turning at {spin_rad_s:.3e} rad/s, faster than \
+         any body moves: the simulation came apart (stiffer gains than the physics rate can hold? raise the rate or \
+         lower the gains)"
+    )]
+    Unstable { time_s: f64, joint: &'static str, speed_m_s: f64, spin_rad_s: f64 },
+}
+
 /// One frame of an execution.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ExecutedFrame {
@@ -158,6 +171,10 @@ pub struct Summary {
     pub pelvis_tilt_rms_error_deg: f64,
     /// Frames on which some joint lay beyond its limits.
     pub clamped_frames: usize,
+    /// On a free base, how far the first frame was raised (negative:
+    /// lowered) to stand on the ground, m.
+    #[serde(serialize_with = "rounded")]
+    pub start_raised_m: f64,
     /// On a free base, how far each foot (left, right) was turned to stand
     /// flat at the start (0 where it was not), to six decimals.
     pub feet_levelled_deg: [f64; 2],
@@ -237,7 +254,7 @@ pub fn execute(
     motion: &Motion,
     params: &ValidExecuteParams,
     mut progress: impl FnMut(),
-) -> Result<Execution, TargetsError> {
+) -> Result<Execution, ExecuteError> {
     let ExecuteParams { base, balance, assist, gains, rate_hz } = params.0;
     let balance = balance && base == Base::Free;
     let (levelled, feet_levelled_rad) = match base {
@@ -258,7 +275,6 @@ pub fn execute(
     let mut fell_at_s = None;
     let mut max_joint_gap_m = 0.0f64;
     let standing = motion.body.pelvis_height();
-    let asked_leans: Vec<f64> = (0..targets.frames()).map(|k| lean(&motion.body.forward(targets.pose(k)))).collect();
 
     let mut frames = Vec::with_capacity(targets.frames());
     // Where the humanoid's pelvis was put against the trajectory's.
@@ -280,6 +296,7 @@ pub fn execute(
     progress();
     for k in 1..targets.frames() {
         let (mut departure_rad, mut wrench) = (0.0, Wrench::default());
+        let asked_lean = lean(&motion.body.forward(targets.pose(k)));
         for s in 1..=steps_per_frame {
             let time_s = (k - 1) as f64 * frame_time + s as f64 * dt;
             targets.sample(time_s, &mut asked);
@@ -294,6 +311,9 @@ pub fn execute(
                 humanoid.assist_toward(&targets.root_at(time_s), offset);
             }
             humanoid.step(&asked, gains);
+            if let Some((joint, speed_m_s, spin_rad_s)) = humanoid.runaway() {
+                return Err(ExecuteError::Unstable { time_s, joint: joint.name(), speed_m_s, spin_rad_s });
+            }
             if assist {
                 wrench = humanoid.assist_wrench();
                 force_sum += wrench.force.length();
@@ -306,7 +326,7 @@ pub fn execute(
                 peak[j.index()] = peak[j.index()].max(torque[j.index()].length());
                 limited_steps[j.index()] += usize::from(at_limit[j.index()]);
             }
-            if fell_at_s.is_none() && base == Base::Free && fallen(&humanoid, standing, asked_leans[k]) {
+            if fell_at_s.is_none() && base == Base::Free && fallen(&humanoid, standing, asked_lean) {
                 fell_at_s = Some(time_s);
             }
         }
@@ -352,6 +372,7 @@ pub fn execute(
         max_error_deg: max_deg(&mut motorized().flat_map(errors)),
         pelvis_tilt_rms_error_deg: rms_deg(&mut errors(Joint::Pelvis)),
         clamped_frames: targets.frames_clamped(),
+        start_raised_m: humanoid.raised_m(),
         feet_levelled_deg: feet_levelled_rad.map(|r| round6(r.to_degrees())),
         max_joint_gap_mm: max_joint_gap_m * 1e3,
         min_balance_margin_m: scored
@@ -616,6 +637,30 @@ mod tests {
             local[j.index()] = DQuat::from_rotation_x(each_deg.to_radians());
         }
         Pose::from_rotations(Pose::rest(body).root, &local)
+    }
+
+    #[test]
+    fn a_simulation_that_comes_apart_stops_with_a_message_instead_of_writing_nans() {
+        // An elbow flipping 150° every 0.1 ms starts spinning at ~26000
+        // rad/s, which no body does.
+        let body = Body::standard();
+        let poses = (0..20)
+            .map(|k| {
+                let mut local = [DQuat::IDENTITY; JOINTS];
+                let angle = if k % 2 == 0 { 0.0 } else { 150f64.to_radians() };
+                local[Joint::LeftElbow.index()] = DQuat::from_axis_angle(-DVec3::Y, angle);
+                Pose::from_rotations(Pose::rest(&body).root, &local)
+            })
+            .collect();
+        let motion = Motion { body, frame_time_s: 1e-4, poses };
+        let params = ExecuteParams { base: Base::Fixed, ..ExecuteParams::default() }.check().unwrap();
+        match execute(&motion, &params, || {}) {
+            // The arm that flips, at its shoulder or below.
+            Err(ExecuteError::Unstable { joint, spin_rad_s, .. }) => {
+                assert!(spin_rad_s > 1000.0 && joint.starts_with("left_"), "{joint} {spin_rad_s}");
+            }
+            other => panic!("{:?}", other.map(|e| e.summary)),
+        }
     }
 
     #[test]

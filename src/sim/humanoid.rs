@@ -124,6 +124,9 @@ pub struct Humanoid {
     colliders: [ColliderHandle; JOINTS],
     /// The ground's collider, on a free base.
     ground: Option<ColliderHandle>,
+    /// How far the pose was raised (negative: lowered) to stand on the
+    /// ground, m; 0 on a fixed base.
+    raised_m: f64,
     actuators: Vec<Actuator>,
     /// Per joint, the most torque each of its motors may apply, N·m (0 for
     /// the pelvis, which has none).
@@ -157,6 +160,8 @@ impl Gains {
 const GROUND: Group = Group::GROUP_2;
 const BODY: Group = Group::GROUP_1;
 pub(super) const GRAVITY_M_S2: f64 = 9.81;
+const RUNAWAY_M_S: f64 = 100.0;
+const RUNAWAY_RAD_S: f64 = 1000.0;
 /// Every actuator's joint stays in the world it was put in.
 const JOINT: &str = "the humanoid's joints are never removed";
 pub(super) const FEET: [Joint; 2] = [Joint::LeftAnkle, Joint::RightAnkle];
@@ -178,13 +183,14 @@ impl Humanoid {
         let shapes = shapes(body);
         let inertials = inertials(body);
         let mut frame = body.forward(pose);
-        let mut ground = None;
+        let (mut ground, mut raised_m) = (None, 0.0);
         if base == Base::Free {
             let lowest = Joint::ALL
                 .iter()
                 .map(|&j| shapes[j.index()].lowest(frame.position(j), frame.rotation(j)))
                 .fold(f64::INFINITY, f64::min);
-            let lift = DVec3::Y * -lowest;
+            raised_m = -lowest;
+            let lift = DVec3::Y * raised_m;
             frame.positions.iter_mut().for_each(|p| *p += lift);
             // The ground: a slab whose top is y = 0, far wider than any walk.
             let slab = ColliderBuilder::cuboid(1000.0, 1.0, 1000.0).collision_groups(groups(GROUND)).friction(1.0);
@@ -230,6 +236,7 @@ impl Humanoid {
             links,
             colliders,
             ground,
+            raised_m,
             actuators,
             torque_limits,
             inertials,
@@ -395,6 +402,25 @@ impl Humanoid {
                 Some((frame.position(j) - expected).length())
             })
             .fold(0.0, f64::max)
+    }
+
+    /// How far the pose it was made in was raised (negative: lowered) to
+    /// stand on the ground, m.
+    pub fn raised_m(&self) -> f64 {
+        self.raised_m
+    }
+
+    /// A link moving faster than any part of a body does (or not finitely):
+    /// the joint, its speed (m/s) and its spin (rad/s). A person's fastest
+    /// limb, a pitching hand, reaches ~40 m/s and ~100 rad/s; beyond
+    /// `RUNAWAY_M_S` or `RUNAWAY_RAD_S` the simulation has come apart.
+    pub fn runaway(&self) -> Option<(Joint, f64, f64)> {
+        Joint::ALL.into_iter().find_map(|j| {
+            let rigid = &self.world.bodies[self.links[j.index()]];
+            let (speed, spin) = (f64::from(rigid.linvel().length()), f64::from(rigid.angvel().length()));
+            let sane = speed <= RUNAWAY_M_S && spin <= RUNAWAY_RAD_S;
+            (!sane).then_some((j, speed, spin))
+        })
     }
 
     /// The most torque each of joint `j`'s motors may apply, N·m.

@@ -67,11 +67,17 @@ fn read_motion(path: &Path) -> Motion {
 /// Writes `path`: a canonical take of `frames` frames at 30 Hz, each the
 /// rest pose as `shape` (given the frame) sets its joint-space numbers.
 fn write_take(path: &Path, frames: usize, shape: impl Fn(usize, &mut [f64])) -> PathBuf {
+    write_poses(path, frames, |k, p| shape(k, &mut p.x))
+}
+
+/// A take on the standard body of `frames` poses, each the rest pose as
+/// `shape` changes it.
+fn write_poses(path: &Path, frames: usize, shape: impl Fn(usize, &mut Pose)) -> PathBuf {
     let body = Body::standard();
     let poses: Vec<Pose> = (0..frames)
         .map(|k| {
             let mut p = Pose::rest(&body);
-            shape(k, &mut p.x);
+            shape(k, &mut p);
             p
         })
         .collect();
@@ -213,6 +219,25 @@ fn standing_on_the_ground_a_waving_humanoid_stays_up_and_one_bent_double_falls_a
     let weight = number(&s, "mass_kg") * 9.81;
     let share = number(assist, "mean_force_share_of_weight");
     assert!((share * weight - number(assist, "mean_force_n")).abs() < 1e-3 && share > 0.0, "{assist}");
+}
+
+#[test]
+fn a_take_that_starts_in_the_air_or_under_the_floor_says_so_and_starts_standing() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, by, said) in [("air", 0.5, "above the floor (in the air)"), ("under", -0.3, "below the floor")] {
+        let take = write_poses(&dir.path().join(format!("{name}.bvh")), 30, |_, p| p.root.y += by);
+        let run = dir.path().join(name);
+        let out = execute(&take, &run, &[]);
+        assert!(out.status.success(), "{}", stderr_of(&out));
+        assert!(stderr_of(&out).contains(said), "{name}: {}", stderr_of(&out));
+        let s: Value = serde_json::from_slice(&fs::read(run.join("summary.json")).unwrap()).unwrap();
+        assert!((number(&s, "start_raised_m") + by).abs() < 1e-3, "{name}: {s}");
+        assert_eq!(s["fell"], false, "{name}: {s}");
+    }
+    // Standing on the floor, nothing is said.
+    let take = write_poses(&dir.path().join("floor.bvh"), 30, |_, _| {});
+    let out = execute(&take, &dir.path().join("floor"), &[]);
+    assert!(!stderr_of(&out).contains("the floor"), "{}", stderr_of(&out));
 }
 
 #[test]
