@@ -1,8 +1,12 @@
 //! What an `imitate execute` of a run's virtual trajectory adds to the run's
-//! report: how closely the humanoid followed it, joint by joint, and a
-//! filmstrip of the humanoid over the trajectory.
+//! report: how closely the humanoid followed it, joint by joint, how it
+//! kept its balance (the margin, what it gave up of the trajectory, the
+//! assistance it had) over time, and a filmstrip of the humanoid over the
+//! trajectory.
 
 use super::metrics::{ReportError, Track};
+use super::plot::{Chart, Figure, Point, Series, Style};
+use super::{Curves, Table};
 use crate::mocap::bvh::read_bvh;
 use crate::mocap::retarget::{RetargetOptions, Retargeter};
 use std::path::Path;
@@ -17,7 +21,19 @@ pub struct ExecutionSummary {
     pub rms_error_deg: f64,
     pub max_error_deg: f64,
     pub fell_at_s: Option<f64>,
+    /// Absent in executions written before it was.
+    #[serde(default)]
+    pub min_balance_margin_m: Option<f64>,
+    #[serde(default)]
+    pub assist: Option<AssistRow>,
     pub joints: Vec<JointRow>,
+}
+
+#[derive(Debug, Clone, serde::Deserialize)]
+pub struct AssistRow {
+    pub mean_force_n: f64,
+    pub max_force_n: f64,
+    pub mean_force_share_of_weight: f64,
 }
 
 #[derive(Debug, Clone, serde::Deserialize)]
@@ -36,6 +52,11 @@ pub struct JointRow {
 pub struct Imitation {
     pub summary: ExecutionSummary,
     pub humanoid: Track,
+    /// From `execution.csv`: each frame's time and its balance columns
+    /// (`balance_margin_m`, `departure_deg`, `assist_force_n`), those the
+    /// file has.
+    pub time_s: Vec<f64>,
+    pub balance: Curves,
 }
 
 /// Reads the `execute` folder `dir` (its `summary.json` and
@@ -51,7 +72,7 @@ pub fn read_imitation(dir: &Path, run: &Track) -> Result<Imitation, ReportError>
             file,
             message: format!(
                 "the humanoid played {} frames (after skipping {}), but {} has {}: execute the run's \
-                 trajectory.bvh whole",
+                 trajectory.bvh whole (--skip 0)",
                 summary.frames,
                 summary.skipped_frames,
                 run.file,
@@ -69,6 +90,18 @@ pub fn read_imitation(dir: &Path, run: &Track) -> Result<Imitation, ReportError>
         let message = format!("{} frames, but its summary.json says {}", motion.poses.len(), summary.frames);
         return Err(ReportError::Summary { file, message });
     }
+    let table = Table::read(&dir.join("execution.csv"))?;
+    let times = table.column("time_s")?.unwrap_or_default();
+    if times.len() != summary.frames || times.iter().any(Option::is_none) {
+        let message = format!("{} rows with a time, but its summary.json says {} frames", times.len(), summary.frames);
+        return Err(ReportError::Summary { file: table.file, message });
+    }
+    let mut balance = Curves::new();
+    for name in BALANCE_COLUMNS {
+        if let Some(values) = table.column(name)? {
+            balance.push((name.to_string(), values));
+        }
+    }
     let frames: Vec<_> = motion.poses.iter().map(|p| motion.body.forward(p)).collect();
     let humanoid = Track {
         file,
@@ -78,8 +111,11 @@ pub fn read_imitation(dir: &Path, run: &Track) -> Result<Imitation, ReportError>
         root: motion.poses.iter().map(|p| p.root).collect(),
         joints: frames.iter().map(|f| f.positions).collect(),
     };
-    Ok(Imitation { summary, humanoid })
+    Ok(Imitation { summary, humanoid, time_s: times.into_iter().flatten().collect(), balance })
 }
+
+/// The columns of `execution.csv` the balance figure draws.
+const BALANCE_COLUMNS: [&str; 3] = ["balance_margin_m", "departure_deg", "assist_force_n"];
 
 impl Imitation {
     /// One sentence: how the humanoid was held and how it followed.
@@ -94,7 +130,46 @@ impl Imitation {
             "The virtual trajectory played on the simulated humanoid at {:.0} Hz (imitate execute): its joints followed \
              within {:.2}° RMS, {:.1}° at worst, {ending}.",
             s.rate_hz, s.rms_error_deg, s.max_error_deg
-        )
+        ) + &match (&s.assist, s.min_balance_margin_m) {
+            (Some(a), _) => format!(
+                " It was assisted: a pull on its pelvis of {:.0} N on average ({:.1}% of its weight), {:.0} N at most.",
+                a.mean_force_n,
+                100.0 * a.mean_force_share_of_weight,
+                a.max_force_n
+            ),
+            (None, Some(m)) if m < 0.0 => {
+                format!(" Its capture point left its feet by up to {:.0} mm (a negative balance margin).", -1e3 * m)
+            }
+            (None, Some(m)) => format!(" Its capture point stayed at least {:.0} mm inside its feet.", 1e3 * m),
+            (None, None) => String::new(),
+        }
+    }
+
+    /// The balance over time, one panel per column the execution has that
+    /// says something (a fixed base has no margin; without assistance the
+    /// force is zero throughout): `None` when none does.
+    pub fn balance_figure(&self, width: u32) -> Option<Figure> {
+        let panels: Vec<Chart> = self
+            .balance
+            .iter()
+            .filter(|(_, values)| values.iter().flatten().any(|&v| v != 0.0))
+            .map(|(name, values)| {
+                let (title, unit) = match name.as_str() {
+                    "balance_margin_m" => ("balance margin: the capture point inside the support polygon", "m"),
+                    "departure_deg" => ("departure: the most the balance turned a joint from the trajectory", "°"),
+                    _ => ("assistance: the pull on the pelvis", "N"),
+                };
+                let points = self
+                    .time_s
+                    .iter()
+                    .zip(values)
+                    .filter_map(|(&t, v)| v.map(|v| Point { size: 0.0, ..Point::new(t, v) }))
+                    .collect();
+                let series = vec![Series { name: String::new(), color: 0, style: Style::Line, points }];
+                Chart::fitted(title, "time (s)", unit, series)
+            })
+            .collect();
+        (!panels.is_empty()).then(|| Figure::new(width, 180, panels))
     }
 
     /// Per joint: name, RMS and worst error (°), peak torque and its cap

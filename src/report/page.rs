@@ -149,6 +149,19 @@ pub fn run_report(
         page.paragraph(&imitation.sentence());
         let header = ["joint", "RMS error (°)", "worst (°)", "peak torque (N·m)", "cap (N·m)", "steps at cap"];
         page.table(&header.map(String::from), &imitation.rows());
+        if let Some(figure) = imitation.balance_figure(figures::WIDTH) {
+            let (png, svg) = (figure.png(), figure.svg());
+            page.image(
+                &png,
+                "image/png",
+                "the humanoid's balance over time",
+                "How far the capture point (where the body would come to rest without stepping) lay inside the \
+                 support polygon of the feet on the ground, negative outside; how far the balance turned the targets \
+                 away from the trajectory to stay up; and, when assisted, the force pulling the pelvis.",
+            );
+            files.push(("balance.png".into(), png));
+            files.push(("balance.svg".into(), svg.into_bytes()));
+        }
         if !picks.is_empty() {
             let strip = filmstrip(camera, &run.track, Some(&imitation.humanoid), picks, observed);
             page.image(

@@ -114,6 +114,16 @@ fn a_run_becomes_a_self_contained_page_whose_numbers_are_those_of_metrics_json()
     assert_eq!(strip.width(), image::open(report.join("filmstrip.png")).unwrap().width());
     // The rest of the report is as without it.
     assert_eq!(fs::read(dir.join("imitation/metrics.json")).unwrap(), fs::read(report.join("metrics.json")).unwrap());
+    // On a stand there is no balance to show.
+    assert!(!dir.join("imitation/balance.png").exists());
+    // Standing on the ground with assistance, the balance over time: the
+    // margin, the departure and the pull, one panel each.
+    ok(run(dir, &["execute", "run/trajectory.bvh", "-o", "standing", "--assist", "--skip", "0"]));
+    ok(run(dir, &["report", "run", "--execution", "standing", "-o", "assisted"]));
+    let html = fs::read_to_string(dir.join("assisted/index.html")).unwrap();
+    assert!(html.contains("It was assisted: a pull on its pelvis of"), "the assistance is said");
+    let balance = image::open(dir.join("assisted/balance.png")).unwrap();
+    assert_eq!(balance.height(), 3 * 180, "three panels");
 
     // A baseline run has no primitives' curves: the page says so and still
     // shows the error and the filmstrip.
