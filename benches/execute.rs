@@ -1,6 +1,6 @@
 //! Simulation speed: the shipped wave-h take (30 Hz, 12.9 s) played on the
-//! humanoid at 240 Hz, on a fixed base and standing on the ground (with
-//! balance). Each iteration builds the humanoid and plays the whole take,
+//! humanoid at 240 Hz, on a fixed base, standing on the ground (with
+//! balance) and standing with assistance (`--assist`). Each iteration builds the humanoid and plays the whole take,
 //! as `imitate execute` does. Throughput is physics steps a second; at
 //! 240 Hz the real-time factor is that over 240.
 //!
@@ -19,9 +19,12 @@ fn simulate(c: &mut Criterion) {
     let motion = &corpus.takes[0].motion;
     let mut group = c.benchmark_group("execute_240hz");
     group.sample_size(10);
-    for (name, base) in [("fixed_base", Base::Fixed), ("free_base", Base::Free)] {
-        let params =
-            ExecuteParams { base, ..ExecuteParams::default() }.check().expect("the standard settings are valid");
+    let settings =
+        [("fixed_base", Base::Fixed, false), ("free_base", Base::Free, false), ("assisted", Base::Free, true)];
+    for (name, base, assist) in settings {
+        let params = ExecuteParams { base, assist, ..ExecuteParams::default() }
+            .check()
+            .expect("the standard settings are valid");
         let steps = execute(motion, &params, || {}).expect("the take plays").summary.steps;
         group.throughput(Throughput::Elements(steps as u64));
         group.bench_function(BenchmarkId::new(name, format!("{:.1}s", motion.duration_s())), |b| {
