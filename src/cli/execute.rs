@@ -4,10 +4,16 @@ use super::retarget::RetargetArgs;
 use super::segment::take;
 use super::{Global, Outcome, UsageError, note, progress, refuse_nonempty};
 use anyhow::Context;
+use imitate::mocap::pose::Motion;
 use imitate::params::{InvalidField, Params};
-use imitate::sim::execute::{ExecuteParams, ExecuteParamsError, execute, frames_to_skip};
+use imitate::report::run::Run;
+use imitate::sim::execute::{
+    ExecuteParams, ExecuteParamsError, Playback, PrimitivesImitation, ValidExecuteParams, execute, frames_to_skip,
+};
 use imitate::sim::humanoid::{Base, Gains};
-use std::path::PathBuf;
+use imitate::sim::superpose::superpose;
+use imitate::vocab::vocabulary::Vocabulary;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Play a trajectory on a simulated humanoid (rapier3d): the canonical body
@@ -21,8 +27,17 @@ use std::time::Instant;
 /// DIR/execution.csv and DIR/summary.json (see docs/formats.md).
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The trajectory: a BVH file.
-    pub input: PathBuf,
+    /// The trajectory: a BVH file (with --primitives, the run's
+    /// trajectory.bvh instead).
+    #[arg(required_unless_present = "primitives", conflicts_with = "primitives")]
+    pub input: Option<PathBuf>,
+    /// Imitate with the primitives: play the `track` run RUN_DIR through
+    /// its vocabulary, each frame's target the superposition of the
+    /// primitives' predictions (eq. 1, 2) weighted by the run's
+    /// recognition probabilities, and compare with playing the run's
+    /// trajectory.bvh as it is (both with the settings given).
+    #[arg(long, value_name = "RUN_DIR", conflicts_with = "skip")]
+    pub primitives: Option<PathBuf>,
     /// The folder to write (refused if it exists and is not empty, unless
     /// --force).
     #[arg(short, long)]
@@ -94,8 +109,16 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         UsageError(e.naming(&flag))
     })?;
     refuse_nonempty(&args.output, args.force)?;
-    let (mut motion, _) = take(&args.input, None, &args.retarget, global)?;
-    let input = args.input.display().to_string();
+    let path = match (&args.input, &args.primitives) {
+        (Some(input), _) => input.clone(),
+        (None, Some(run)) => run.join("trajectory.bvh"),
+        (None, None) => unreachable!("clap asks for one of them"),
+    };
+    let (mut motion, _) = take(&path, None, &args.retarget, global)?;
+    let input = path.display().to_string();
+    if let Some(run) = &args.primitives {
+        return imitate_with_primitives(run, &motion, &params, &args.output, global);
+    }
     let Some((skip, bind_pose)) = frames_to_skip(&motion, args.skip) else {
         let frames = motion.poses.len();
         return Err(UsageError(format!("--skip {}: {input} has only {frames} frames", args.skip.unwrap_or(0))).into());
@@ -152,6 +175,83 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             summary.duration_s,
             summary.duration_s / seconds,
             seconds * 1e6 / summary.steps.max(1) as f64,
+        ),
+    );
+    Ok(Outcome::Success)
+}
+
+/// `execute --primitives RUN`: the run's trajectory (`trajectory`) re-made
+/// by its vocabulary's primitives, played, and set beside the trajectory
+/// played as it is.
+fn imitate_with_primitives(
+    run_dir: &Path,
+    trajectory: &Motion,
+    params: &ValidExecuteParams,
+    output: &Path,
+    global: Global,
+) -> anyhow::Result<Outcome> {
+    let run = Run::read(run_dir)?;
+    let summary_path = run_dir.join("summary.json").display().to_string();
+    if run.summary.baseline.is_some() {
+        anyhow::bail!("{summary_path}: a --baseline run recognizes no primitives, so none can imitate it");
+    }
+    let vocab_path = PathBuf::from(&run.summary.vocabulary.path);
+    let vocabulary = Vocabulary::load(&vocab_path).with_context(|| {
+        format!("{summary_path} names the vocabulary {}, which cannot be read", vocab_path.display())
+    })?;
+    let found = vocabulary.checksum().map(|c| format!("{c:08x}"));
+    if let (Some(tracked), Some(found)) = (&run.summary.vocabulary.checksum, &found)
+        && tracked != found
+    {
+        anyhow::bail!(
+            "{summary_path}: the run was tracked with a vocabulary of checksum {tracked}, but {} is {found} now: \
+             a run of another vocabulary",
+            vocab_path.display()
+        );
+    }
+    let probabilities: Vec<Vec<Option<f64>>> = run.probabilities.iter().map(|(_, p)| p.clone()).collect();
+    let superposed = superpose(trajectory, &vocabulary, &run.names(), &probabilities)
+        .with_context(|| format!("{} against {}", run_dir.display(), vocab_path.display()))?;
+    let input = run_dir.join("trajectory.bvh").display().to_string();
+    let bar = progress(global, 2 * trajectory.poses.len() as u64, "execute");
+    let started = Instant::now();
+    let played = execute(trajectory, params, || bar.inc(1)).with_context(|| input.clone())?;
+    let mut imitated = execute(&superposed.motion, params, || bar.inc(1)).with_context(|| input.clone())?;
+    let seconds = started.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let comparison = PrimitivesImitation {
+        run: run_dir.display().to_string(),
+        vocabulary: vocab_path.display().to_string(),
+        superposed_frames: superposed.superposed_frames,
+        kept_frames: superposed.kept_frames,
+        rms_error_from_trajectory_deg: imitated.rms_error_against_deg(trajectory),
+        trajectory_playback: Playback {
+            rms_error_deg: played.summary.rms_error_deg,
+            jerk_rms_m_s3: played.summary.jerk_rms_m_s3,
+            fell_at_s: played.summary.fell_at_s,
+        },
+    };
+    imitated.summary.primitives = Some(comparison.clone());
+    imitated.write(output, &input, 0)?;
+    let s = &imitated.summary;
+    let fell = |at: Option<f64>| at.map_or("stayed up".to_string(), |t| format!("fell at {t:.2} s"));
+    note(
+        global,
+        &format!(
+            "{input}: {} of {} frames made by the primitives of {}: {:.2}° RMS from the trajectory, jerk {:.1} m/s³, \
+             {}; the trajectory played as it is: {:.2}° RMS, jerk {:.1} m/s³, {} → {}\n\
+             simulated 2 × {:.2} s in {seconds:.3} s",
+            comparison.superposed_frames,
+            s.frames,
+            comparison.vocabulary,
+            comparison.rms_error_from_trajectory_deg,
+            s.jerk_rms_m_s3,
+            fell(s.fell_at_s),
+            comparison.trajectory_playback.rms_error_deg,
+            comparison.trajectory_playback.jerk_rms_m_s3,
+            fell(comparison.trajectory_playback.fell_at_s),
+            output.display(),
+            s.duration_s,
         ),
     );
     Ok(Outcome::Success)

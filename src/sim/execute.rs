@@ -194,11 +194,46 @@ pub struct Summary {
     pub departure_rms_deg: f64,
     #[serde(serialize_with = "rounded")]
     pub departure_max_deg: f64,
+    /// How smoothly the humanoid moved: the RMS over every joint and frame
+    /// (from the second) of its position's third derivative (m/s³, by
+    /// finite differences at the frame rate).
+    #[serde(serialize_with = "rounded")]
+    pub jerk_rms_m_s3: f64,
     /// The assistance's size over every step: `None` without it.
     pub assist: Option<AssistSummary>,
+    /// With `--primitives`: the run imitated, and the same trajectory
+    /// played as it was, for comparison; `None` otherwise.
+    pub primitives: Option<PrimitivesImitation>,
     pub fell: bool,
     pub fell_at_s: Option<f64>,
     pub joints: Vec<JointSummary>,
+}
+
+/// An imitation by the primitives (`execute --primitives`) beside the
+/// trajectory played as it was.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct PrimitivesImitation {
+    /// The run folder and the vocabulary it was tracked with.
+    pub run: String,
+    pub vocabulary: String,
+    pub superposed_frames: usize,
+    pub kept_frames: usize,
+    /// This execution's joint error against the run's trajectory (not its
+    /// own targets).
+    #[serde(serialize_with = "rounded")]
+    pub rms_error_from_trajectory_deg: f64,
+    /// The run's trajectory played as it was, with the same settings.
+    pub trajectory_playback: Playback,
+}
+
+/// The numbers of an execution set beside another.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Playback {
+    #[serde(serialize_with = "rounded")]
+    pub rms_error_deg: f64,
+    #[serde(serialize_with = "rounded")]
+    pub jerk_rms_m_s3: f64,
+    pub fell_at_s: Option<f64>,
 }
 
 /// How hard the assistance pulled, over every physics step.
@@ -382,6 +417,7 @@ pub fn execute(
             .min_by(f64::total_cmp),
         departure_rms_deg: rms_deg(&mut scored.iter().map(|f| f.departure_rad)),
         departure_max_deg: max_deg(&mut scored.iter().map(|f| f.departure_rad)),
+        jerk_rms_m_s3: jerk_rms(&motion.body, &scored.iter().map(|f| f.achieved).collect::<Vec<_>>(), frame_time),
         assist: assist.then(|| {
             let mass = body_mass_kg(&motion.body);
             let mean_force_n = force_sum / steps.max(1) as f64;
@@ -393,6 +429,7 @@ pub fn execute(
                 max_torque_nm: torque_max,
             }
         }),
+        primitives: None,
         fell: fell_at_s.is_some(),
         fell_at_s,
         joints,
@@ -437,6 +474,21 @@ fn level_feet(motion: &Motion) -> (Motion, [f64; 2]) {
         turned[k] = tilt;
     }
     (out, turned)
+}
+
+/// The RMS of every joint's third derivative of position over `poses`,
+/// m/s³; 0 for fewer than four poses.
+pub fn jerk_rms(body: &crate::mocap::body::Body, poses: &[Pose], frame_time_s: f64) -> f64 {
+    let frames: Vec<BodyFrame> = poses.iter().map(|p| body.forward(p)).collect();
+    let (mut squares, mut count) = (0.0, 0usize);
+    for w in frames.windows(4) {
+        for j in Joint::ALL {
+            let [a, b, c, d] = [&w[0], &w[1], &w[2], &w[3]].map(|f| f.position(j));
+            squares += ((d - 3.0 * c + 3.0 * b - a) / frame_time_s.powi(3)).length_squared();
+            count += 1;
+        }
+    }
+    if count == 0 { 0.0 } else { (squares / count as f64).sqrt() }
 }
 
 /// The angle between the trunk (pelvis to neck) and the vertical.
@@ -556,6 +608,21 @@ impl Execution {
             |e| e,
         )
         .map_err(WriteError::at(dir))
+    }
+
+    /// The RMS angle (degrees) between each joint's reached rotation and
+    /// `motion`'s (frame by frame, every joint but the pelvis, every frame
+    /// but the first): how far the humanoid was from a trajectory other
+    /// than its targets.
+    pub fn rms_error_against_deg(&self, motion: &Motion) -> f64 {
+        let (mut squares, mut count) = (0.0, 0usize);
+        for (f, pose) in self.frames.iter().zip(&motion.poses).skip(1) {
+            for j in motorized() {
+                squares += angle_between(pose.local_rotation(j), f.achieved.local_rotation(j)).powi(2);
+                count += 1;
+            }
+        }
+        (squares / count.max(1) as f64).sqrt().to_degrees()
     }
 
     /// What the humanoid did, on the canonical skeleton, at the

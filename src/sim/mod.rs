@@ -7,4 +7,5 @@ pub mod assist;
 pub mod balance;
 pub mod execute;
 pub mod humanoid;
+pub mod superpose;
 pub mod targets;

@@ -195,3 +195,36 @@ fn bad_input_is_refused_with_nothing_written() {
     refused(dir, &["report", "run", "-o", "taken"], "taken: exists and is not empty");
     assert_eq!(fs::read_to_string(dir.join("taken/keep.txt")).unwrap(), "mine");
 }
+
+#[test]
+fn the_primitives_imitate_a_run_more_smoothly_than_its_trajectory_and_refuse_another_vocabulary() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    tracked(dir);
+    ok(run(dir, &["execute", "--primitives", "run", "-o", "imitated", "--fixed-base"]));
+    let s: serde_json::Value = serde_json::from_slice(&fs::read(dir.join("imitated/summary.json")).unwrap()).unwrap();
+    let p = &s["primitives"];
+    let frames = s["frames"].as_u64().unwrap();
+    assert_eq!(p["superposed_frames"].as_u64().unwrap() + p["kept_frames"].as_u64().unwrap(), frames);
+    assert!(p["superposed_frames"].as_u64().unwrap() > frames / 2, "{p}");
+    // The primitives' motion is smoother than the arbitrated poses'.
+    let (jerk, played) =
+        (s["jerk_rms_m_s3"].as_f64().unwrap(), p["trajectory_playback"]["jerk_rms_m_s3"].as_f64().unwrap());
+    assert!(jerk < played, "jerk {jerk} against {played} m/s³");
+    assert!(p["rms_error_from_trajectory_deg"].as_f64().unwrap() < 15.0, "{p}");
+
+    // A run of another vocabulary, a baseline run, both a trajectory and a run.
+    let summary = fs::read_to_string(dir.join("run/summary.json")).unwrap();
+    let value: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    let checksum = value["vocabulary"]["checksum"].as_str().unwrap().to_string();
+    fs::create_dir(dir.join("other")).unwrap();
+    for file in ["frames.csv", "likelihoods.csv", "trajectory.bvh"] {
+        fs::copy(dir.join("run").join(file), dir.join("other").join(file)).unwrap();
+    }
+    fs::write(dir.join("other/summary.json"), summary.replace(&checksum, "00000000")).unwrap();
+    refused(dir, &["execute", "--primitives", "other", "-o", "out"], "a run of another vocabulary");
+    refused(dir, &["execute", "--primitives", "baseline", "-o", "out"], "recognizes no primitives");
+    assert!(!dir.join("out").exists());
+    let out = run(dir, &["execute", "run/trajectory.bvh", "--primitives", "run", "-o", "out"]);
+    assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+}
