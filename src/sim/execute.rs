@@ -25,7 +25,7 @@ pub struct ExecuteParams {
     /// over the feet ([`Humanoid::balance`]).
     pub balance: bool,
     /// On a free base, pull the pelvis toward the trajectory's with a
-    /// residual force and torque ([`Humanoid::assist`]), reported.
+    /// residual force and torque ([`super::assist`]), reported.
     pub assist: bool,
     pub gains: Gains,
     /// Physics steps a second; rounded up to a whole number of steps per
