@@ -6,9 +6,12 @@ use super::{Global, Outcome, UsageError, note, progress, refuse_nonempty};
 use anyhow::Context;
 use imitate::mocap::pose::Motion;
 use imitate::params::{InvalidField, Params};
+use imitate::report::metrics::motion_error_mm;
+use imitate::report::read_track;
 use imitate::report::run::Run;
 use imitate::sim::execute::{
-    ExecuteParams, ExecuteParamsError, Playback, PrimitivesImitation, ValidExecuteParams, execute, frames_to_skip,
+    ExecuteParams, ExecuteParamsError, Execution, Playback, PrimitivesImitation, ValidExecuteParams, execute,
+    frames_to_skip,
 };
 use imitate::sim::humanoid::{Base, Gains};
 use imitate::sim::superpose::superpose;
@@ -38,6 +41,11 @@ pub struct Args {
     /// trajectory.bvh as it is (both with the settings given).
     #[arg(long, value_name = "RUN_DIR", conflicts_with = "skip")]
     pub primitives: Option<PathBuf>,
+    /// With --primitives: the demonstrator's true joint positions
+    /// (truth.csv, one row per frame of the run), against which both the
+    /// imitation and the trajectory played are scored.
+    #[arg(long, value_name = "FILE", requires = "primitives")]
+    pub truth: Option<PathBuf>,
     /// The folder to write (refused if it exists and is not empty, unless
     /// --force).
     #[arg(short, long)]
@@ -117,7 +125,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     let (mut motion, _) = take(&path, None, &args.retarget, global)?;
     let input = path.display().to_string();
     if let Some(run) = &args.primitives {
-        return imitate_with_primitives(run, &motion, &params, &args.output, global);
+        return imitate_with_primitives(run, args.truth.as_deref(), &motion, &params, &args.output, global);
     }
     let Some((skip, bind_pose)) = frames_to_skip(&motion, args.skip) else {
         let frames = motion.poses.len();
@@ -185,6 +193,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
 /// played as it is.
 fn imitate_with_primitives(
     run_dir: &Path,
+    truth_path: Option<&Path>,
     trajectory: &Motion,
     params: &ValidExecuteParams,
     output: &Path,
@@ -209,6 +218,15 @@ fn imitate_with_primitives(
             vocab_path.display()
         );
     }
+    let truth = truth_path.map(read_track).transpose()?;
+    let error_mm = |execution: &Execution| -> anyhow::Result<Option<f64>> {
+        let Some(truth) = &truth else { return Ok(None) };
+        let done = execution.motion();
+        let mm = motion_error_mm(&done, truth, 1).ok_or_else(|| {
+            anyhow::anyhow!("{}: {} frames, but the run has {}", truth.file, truth.joints.len(), done.poses.len())
+        })?;
+        Ok(Some(mm))
+    };
     let probabilities: Vec<Vec<Option<f64>>> = run.probabilities.iter().map(|(_, p)| p.clone()).collect();
     let superposed = superpose(trajectory, &vocabulary, &run.names(), &probabilities)
         .with_context(|| format!("{} against {}", run_dir.display(), vocab_path.display()))?;
@@ -225,9 +243,12 @@ fn imitate_with_primitives(
         superposed_frames: superposed.superposed_frames,
         kept_frames: superposed.kept_frames,
         rms_error_from_trajectory_deg: imitated.rms_error_against_deg(trajectory),
+        truth: truth_path.map(|p| p.display().to_string()),
+        upper_body_error_mm: error_mm(&imitated)?,
         trajectory_playback: Playback {
             rms_error_deg: played.summary.rms_error_deg,
             jerk_rms_m_s3: played.summary.jerk_rms_m_s3,
+            upper_body_error_mm: error_mm(&played)?,
             fell_at_s: played.summary.fell_at_s,
         },
     };
@@ -235,19 +256,22 @@ fn imitate_with_primitives(
     imitated.write(output, &input, 0)?;
     let s = &imitated.summary;
     let fell = |at: Option<f64>| at.map_or("stayed up".to_string(), |t| format!("fell at {t:.2} s"));
+    let off = |mm: Option<f64>| mm.map_or(String::new(), |mm| format!(", {mm:.1} mm from the truth"));
     note(
         global,
         &format!(
-            "{input}: {} of {} frames made by the primitives of {}: {:.2}° RMS from the trajectory, jerk {:.1} m/s³, \
-             {}; the trajectory played as it is: {:.2}° RMS, jerk {:.1} m/s³, {} → {}\n\
+            "{input}: {} of {} frames made by the primitives of {}: {:.2}° RMS from the trajectory{}, jerk {:.1} m/s³, \
+             {}; the trajectory played as it is: {:.2}° RMS{}, jerk {:.1} m/s³, {} → {}\n\
              simulated 2 × {:.2} s in {seconds:.3} s",
             comparison.superposed_frames,
             s.frames,
             comparison.vocabulary,
             comparison.rms_error_from_trajectory_deg,
+            off(comparison.upper_body_error_mm),
             s.jerk_rms_m_s3,
             fell(s.fell_at_s),
             comparison.trajectory_playback.rms_error_deg,
+            off(comparison.trajectory_playback.upper_body_error_mm),
             comparison.trajectory_playback.jerk_rms_m_s3,
             fell(comparison.trajectory_playback.fell_at_s),
             output.display(),

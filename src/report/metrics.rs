@@ -201,6 +201,25 @@ pub fn root_relative_m(estimate: &[DVec3; JOINTS], truth: &[DVec3; JOINTS], j: u
     (estimate[j] - estimate[pelvis]).distance(truth[j] - truth[pelvis])
 }
 
+/// The mean over frames (from `from`) of the upper body's root-relative
+/// error (mm, as [`score`] measures it) of `motion`'s poses against
+/// `truth`'s, frame by frame; `None` when `truth` has another number of
+/// frames.
+pub fn motion_error_mm(motion: &Motion, truth: &Track, from: usize) -> Option<f64> {
+    if truth.joints.len() != motion.poses.len() {
+        return None;
+    }
+    let errors: Vec<f64> = motion.poses[from.min(motion.poses.len())..]
+        .iter()
+        .zip(&truth.joints[from.min(truth.joints.len())..])
+        .map(|(pose, t)| {
+            let positions = motion.body.forward(pose).positions;
+            UPPER_BODY.iter().map(|j| root_relative_m(&positions, t, j.index())).sum::<f64>() / UPPER_BODY.len() as f64
+        })
+        .collect();
+    Some(1000.0 * errors.iter().sum::<f64>() / errors.len().max(1) as f64)
+}
+
 /// How far `motion` lies from a vocabulary's primitives: the upper-body
 /// error (root-relative, mm, as [`score`] measures it) of each frame's pose
 /// projected into a primitive's latent space (eq. 3, there and back),

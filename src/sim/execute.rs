@@ -222,7 +222,12 @@ pub struct PrimitivesImitation {
     /// own targets).
     #[serde(serialize_with = "rounded")]
     pub rms_error_from_trajectory_deg: f64,
-    /// The run's trajectory played as it was, with the same settings.
+    /// With `--truth`: that file, and the upper body's root-relative
+    /// error (mm) of what the humanoid did against it.
+    pub truth: Option<String>,
+    #[serde(serialize_with = "rounded_option")]
+    pub upper_body_error_mm: Option<f64>,
+    /// The run's trajectory played as it is, with the same settings.
     pub trajectory_playback: Playback,
 }
 
@@ -233,6 +238,8 @@ pub struct Playback {
     pub rms_error_deg: f64,
     #[serde(serialize_with = "rounded")]
     pub jerk_rms_m_s3: f64,
+    #[serde(serialize_with = "rounded_option")]
+    pub upper_body_error_mm: Option<f64>,
     pub fell_at_s: Option<f64>,
 }
 

@@ -15,9 +15,9 @@
 //! frame being predicted. Measured on the demo's run (`execute
 //! --primitives`): moving by the primitives alone from the estimate
 //! (share 1) left the jerk 1.3× the trajectory's; ½ brought it to 0.4×,
-//! with the upper body's root-relative error against the truth 21.6 mm
-//! standing (the trajectory played: 25.7 mm) and 14.8 mm on a fixed base
-//! (12.7 mm).
+//! with the upper body's root-relative error against the truth 23.9 mm
+//! standing (the trajectory played: 28.5 mm) and 16.4 mm on a fixed base
+//! (14.0 mm).
 
 use crate::mocap::body::JointVector;
 use crate::mocap::pose::{Motion, Pose};
