@@ -10,7 +10,7 @@ use imitate::report::metrics::motion_error_mm;
 use imitate::report::read_track;
 use imitate::report::run::Run;
 use imitate::sim::execute::{
-    ExecuteParams, ExecuteParamsError, Execution, Playback, PrimitivesImitation, ValidExecuteParams, execute,
+    ExecuteParams, ExecuteParamsError, Execution, Playback, PrimitivesImitation, Summary, ValidExecuteParams, execute,
     frames_to_skip,
 };
 use imitate::sim::humanoid::{Base, Gains};
@@ -91,6 +91,23 @@ pub struct Args {
 /// 8 cm, their skeletons' feet unlike the canonical body's).
 const OFF_THE_FLOOR_M: f64 = 0.10;
 
+/// Warns when the trajectory `input` started off the floor (`summary`'s
+/// `start_raised_m`).
+fn warn_off_the_floor(input: &str, summary: &Summary, global: Global) {
+    let raised = summary.start_raised_m;
+    if raised.abs() > OFF_THE_FLOOR_M {
+        let (by, where_) =
+            if raised < 0.0 { (-raised, "above the floor (in the air)") } else { (raised, "below the floor") };
+        note(
+            global,
+            &format!(
+                "{input}: warning: the first frame's lowest point lies {by:.2} m {where_}; the humanoid started \
+                 standing on it"
+            ),
+        );
+    }
+}
+
 /// `KP,KD`.
 fn parse_gains(text: &str) -> Result<Gains, UsageError> {
     let bad = || UsageError(format!("--gains {text}: expected KP,KD, two positive numbers, e.g. 10000,200"));
@@ -149,18 +166,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         None if base == Base::Free => ", stayed up".to_string(),
         None => String::new(),
     };
-    let raised = summary.start_raised_m;
-    if raised.abs() > OFF_THE_FLOOR_M {
-        let (by, where_) =
-            if raised < 0.0 { (-raised, "above the floor (in the air)") } else { (raised, "below the floor") };
-        note(
-            global,
-            &format!(
-                "{input}: warning: the first frame's lowest point lies {by:.2} m {where_}; the humanoid started \
-                 standing on it"
-            ),
-        );
-    }
+    warn_off_the_floor(&input, summary, global);
     let assisted = summary.assist.as_ref().map_or(String::new(), |a| {
         format!(
             " with assistance of {:.0} N on average ({:.1}% of its weight), {:.0} N at most",
@@ -255,6 +261,7 @@ fn imitate_with_primitives(
     imitated.summary.primitives = Some(comparison.clone());
     imitated.write(output, &input, 0)?;
     let s = &imitated.summary;
+    warn_off_the_floor(&input, s, global);
     let fell = |at: Option<f64>| at.map_or("stayed up".to_string(), |t| format!("fell at {t:.2} s"));
     let off = |mm: Option<f64>| mm.map_or(String::new(), |mm| format!(", {mm:.1} mm from the truth"));
     note(

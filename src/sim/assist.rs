@@ -13,10 +13,10 @@
 //! acting on the pelvis's small inertia alone, blew the humanoid apart in
 //! the first step (measured: 10⁵ N at once).
 
-use super::humanoid::Humanoid;
+use super::humanoid::{Humanoid, to_f64};
 use super::targets::RootTarget;
 use crate::mocap::body::Joint;
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 use rapier3d::prelude::*;
 
 /// The pull's natural frequency (rad/s), critically damped: stiff enough to
@@ -74,7 +74,7 @@ impl Humanoid {
     pub fn assist_wrench(&self) -> Wrench {
         let Some((anchor, handle)) = self.anchor else { return Wrench::default() };
         let data = &self.world.impulse_joints.get(handle).expect(ANCHOR).data;
-        let frame = self.world.bodies[anchor].rotation().as_dquat().normalize() * to_dquat(data.local_frame1.rotation);
+        let frame = to_f64(*self.world.bodies[anchor].rotation()) * to_f64(data.local_frame1.rotation);
         let substep = self.substep_s();
         let along = |axes: [JointAxis; 3]| {
             let impulse = axes.map(|a| data.motor(a).map_or(0.0, |m| f64::from(m.impulse)));
@@ -82,8 +82,4 @@ impl Humanoid {
         };
         Wrench { force: along(LINEAR), torque: along(ANGULAR) }
     }
-}
-
-fn to_dquat(q: glam::Quat) -> DQuat {
-    q.as_dquat().normalize()
 }
