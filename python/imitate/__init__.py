@@ -149,7 +149,7 @@ def score(run: PathLike, truth: PathLike, settle: float = 0.5) -> Dict[str, Any]
 
 
 def execute(
-    motion: Union[Motion, PathLike],
+    motion: Union[Motion, PathLike, None] = None,
     out: Optional[PathLike] = None,
     force: bool = False,
     frame: str = "pandas",
@@ -159,6 +159,8 @@ def execute(
     rate: float = 240.0,
     skip: Optional[int] = None,
     assist: bool = False,
+    primitives: Optional[PathLike] = None,
+    truth: Optional[PathLike] = None,
     up: Optional[str] = None,
     mapping: Optional[PathLike] = None,
 ) -> Any:
@@ -174,13 +176,22 @@ def execute(
     is a bind pose, as ``imitate execute`` does; ``skip=0`` keeps it);
     ``assist`` pulls the pelvis toward the trajectory's with a residual
     force and torque, reported in the table (``assist_force_n``,
-    ``assist_torque_nm``). With
+    ``assist_torque_nm``). With ``primitives`` (a ``track`` run folder, in
+    place of ``motion``) the run's trajectory is imitated by its
+    vocabulary's primitives, as ``imitate execute --primitives`` does,
+    scored against ``truth`` (a truth.csv) when given. With
     ``out``, the execution's folder (executed.bvh, execution.csv,
     summary.json) is written there too; a folder that holds something is
     refused unless ``force``."""
     _check_frame(frame)
-    if not isinstance(motion, Motion):
+    if (motion is None) == (primitives is None):
+        raise OptionsError("execute: give a motion or primitives=RUN_DIR, one of them")
+    if primitives is not None:
+        motion = read_bvh(os.path.join(os.fspath(primitives), "trajectory.bvh"), up, mapping)
+    elif not isinstance(motion, Motion):
         motion = read_bvh(motion, up, mapping)
-    text = _imitate.execute_table(motion, out, force, fixed_base, balance, tuple(gains), rate, skip, assist)
+    text = _imitate.execute_table(
+        motion, out, force, fixed_base, balance, tuple(gains), rate, skip, assist, primitives, truth
+    )
     return _table(text, frame)
 

@@ -204,4 +204,6 @@ def execute_table(
     rate: float = 240.0,
     skip: Optional[int] = None,
     assist: bool = False,
+    primitives: Optional[_Path] = None,
+    truth: Optional[_Path] = None,
 ) -> str: ...

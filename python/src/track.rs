@@ -13,6 +13,7 @@ use imitate::report::metrics::{SETTLE_S, score};
 use imitate::report::{read_primitives, read_track};
 use imitate::sim::execute::{ExecuteParams, execute, frames_to_skip};
 use imitate::sim::humanoid::{Base, Gains};
+use imitate::sim::superpose::imitate_run;
 use imitate::track::auto_camera::Focal;
 use imitate::track::clip::{self, CameraChoice, ClipError, ClipOptions, ClipOptionsError, track_clip_with};
 use imitate::track::open_set::OpenSet;
@@ -672,7 +673,7 @@ pub fn score_run(py: Python<'_>, run: PathBuf, truth: PathBuf, settle: f64) -> P
 /// and returns ``execution.csv``'s text, writing the execution's folder
 /// to `out` when given.
 #[pyfunction]
-#[pyo3(signature = (motion, out=None, force=false, fixed_base=false, balance=true, gains=(10000.0, 200.0), rate=240.0, skip=None, assist=false))]
+#[pyo3(signature = (motion, out=None, force=false, fixed_base=false, balance=true, gains=(10000.0, 200.0), rate=240.0, skip=None, assist=false, primitives=None, truth=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn execute_table(
     py: Python<'_>,
@@ -685,6 +686,8 @@ pub fn execute_table(
     rate: f64,
     skip: Option<usize>,
     assist: bool,
+    primitives: Option<PathBuf>,
+    truth: Option<PathBuf>,
 ) -> PyResult<String> {
     let base = if fixed_base { Base::Fixed } else { Base::Free };
     let gains = Gains { kp_per_s2: gains.0, kd_per_s: gains.1 };
@@ -692,8 +695,14 @@ pub fn execute_table(
         let keyword = if e.field() == "rate_hz" { "rate" } else { e.field() };
         raise(Class::Options, e.naming(keyword), None)
     })?;
+    if primitives.is_some() && skip.is_some() {
+        return Err(raise(Class::Options, "skip: the primitives imitate the run's every frame".to_string(), None));
+    }
+    if truth.is_some() && primitives.is_none() {
+        return Err(raise(Class::Options, "truth: scores an imitation by the primitives only".to_string(), None));
+    }
     let mut trajectory = motion.motion.clone();
-    let Some((skip, _)) = frames_to_skip(&trajectory, skip) else {
+    let Some((skip, _)) = frames_to_skip(&trajectory, skip.or(primitives.as_ref().map(|_| 0))) else {
         let (asked, frames) = (skip.unwrap_or(0), trajectory.poses.len());
         return Err(raise(Class::Options, format!("skip: {asked}: {} has only {frames} frames", motion.source), None));
     };
@@ -701,9 +710,14 @@ pub fn execute_table(
     if let Some(out) = &out {
         refuse_nonempty(out, force).map_err(|e| failure(Class::Error, &e, Some(e.0.clone())))?;
     }
-    let execution = py
-        .detach(|| execute(&trajectory, &params, || {}))
-        .map_err(|e| raise(Class::Error, format!("{}: {}", motion.source, imitate::describe(&e)), None))?;
+    let execution = match &primitives {
+        Some(run) => py
+            .detach(|| imitate_run(run, &trajectory, truth.as_deref(), &params, || {}))
+            .map_err(|e| raise(Class::Error, imitate::describe(&e), None))?,
+        None => py
+            .detach(|| execute(&trajectory, &params, || {}))
+            .map_err(|e| raise(Class::Error, format!("{}: {}", motion.source, imitate::describe(&e)), None))?,
+    };
     if let Some(out) = &out {
         execution.write(out, &motion.source, skip).map_err(|e| failure(Class::Error, &e, Some(e.path.clone())))?;
     }

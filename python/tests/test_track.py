@@ -134,6 +134,17 @@ def test_execute_returns_the_cli_execution_table_and_writes_its_folder(tmp_path,
         imitate.execute("mocap/punch.bvh", out=tmp_path / "mine", fixed_base=True)
 
 
+def test_execute_by_the_primitives_matches_the_cli(tmp_path, cli, run_dir):
+    cli("execute", "--primitives", run_dir, "-o", tmp_path / "run", "--fixed-base")
+    table = imitate.execute(primitives=run_dir, out=tmp_path / "mine", fixed_base=True)
+    pd.testing.assert_frame_equal(table, read_csv(tmp_path / "run" / "execution.csv"))
+    assert (tmp_path / "mine" / "summary.json").read_bytes() == (tmp_path / "run" / "summary.json").read_bytes()
+    with pytest.raises(imitate.OptionsError, match="one of them"):
+        imitate.execute("mocap/punch.bvh", primitives=run_dir)
+    with pytest.raises(imitate.OptionsError, match="truth: scores an imitation by the primitives only"):
+        imitate.execute("mocap/punch.bvh", truth="video/truth.csv")
+
+
 def test_execute_with_assistance_matches_the_cli_and_refuses_a_fixed_base(tmp_path, cli):
     cli("execute", "mocap/punch.bvh", "-o", tmp_path / "run", "--assist")
     table = imitate.execute("mocap/punch.bvh", assist=True)

@@ -6,16 +6,9 @@ use super::{Global, Outcome, UsageError, note, progress, refuse_nonempty};
 use anyhow::Context;
 use imitate::mocap::pose::Motion;
 use imitate::params::{InvalidField, Params};
-use imitate::report::metrics::motion_error_mm;
-use imitate::report::read_track;
-use imitate::report::run::Run;
-use imitate::sim::execute::{
-    ExecuteParams, ExecuteParamsError, Execution, Playback, PrimitivesImitation, Summary, ValidExecuteParams, execute,
-    frames_to_skip,
-};
+use imitate::sim::execute::{ExecuteParams, ExecuteParamsError, Summary, ValidExecuteParams, execute, frames_to_skip};
 use imitate::sim::humanoid::{Base, Gains};
-use imitate::sim::superpose::superpose;
-use imitate::vocab::vocabulary::Vocabulary;
+use imitate::sim::superpose::imitate_run;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -199,69 +192,22 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
 /// played as it is.
 fn imitate_with_primitives(
     run_dir: &Path,
-    truth_path: Option<&Path>,
+    truth: Option<&Path>,
     trajectory: &Motion,
     params: &ValidExecuteParams,
     output: &Path,
     global: Global,
 ) -> anyhow::Result<Outcome> {
-    let run = Run::read(run_dir)?;
-    let summary_path = run_dir.join("summary.json").display().to_string();
-    if run.summary.baseline.is_some() {
-        anyhow::bail!("{summary_path}: a --baseline run recognizes no primitives, so none can imitate it");
-    }
-    let vocab_path = PathBuf::from(&run.summary.vocabulary.path);
-    let vocabulary = Vocabulary::load(&vocab_path).with_context(|| {
-        format!("{summary_path} names the vocabulary {}, which cannot be read", vocab_path.display())
-    })?;
-    let found = vocabulary.checksum().map(|c| format!("{c:08x}"));
-    if let (Some(tracked), Some(found)) = (&run.summary.vocabulary.checksum, &found)
-        && tracked != found
-    {
-        anyhow::bail!(
-            "{summary_path}: the run was tracked with a vocabulary of checksum {tracked}, but {} is {found} now: \
-             a run of another vocabulary",
-            vocab_path.display()
-        );
-    }
-    let truth = truth_path.map(read_track).transpose()?;
-    let error_mm = |execution: &Execution| -> anyhow::Result<Option<f64>> {
-        let Some(truth) = &truth else { return Ok(None) };
-        let done = execution.motion();
-        let mm = motion_error_mm(&done, truth, 1).ok_or_else(|| {
-            anyhow::anyhow!("{}: {} frames, but the run has {}", truth.file, truth.joints.len(), done.poses.len())
-        })?;
-        Ok(Some(mm))
-    };
-    let probabilities: Vec<Vec<Option<f64>>> = run.probabilities.iter().map(|(_, p)| p.clone()).collect();
-    let superposed = superpose(trajectory, &vocabulary, &run.names(), &probabilities)
-        .with_context(|| format!("{} against {}", run_dir.display(), vocab_path.display()))?;
     let input = run_dir.join("trajectory.bvh").display().to_string();
     let bar = progress(global, 2 * trajectory.poses.len() as u64, "execute");
     let started = Instant::now();
-    let played = execute(trajectory, params, || bar.inc(1)).with_context(|| input.clone())?;
-    let mut imitated = execute(&superposed.motion, params, || bar.inc(1)).with_context(|| input.clone())?;
+    let imitated = imitate_run(run_dir, trajectory, truth, params, || bar.inc(1))?;
     let seconds = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
-    let comparison = PrimitivesImitation {
-        run: run_dir.display().to_string(),
-        vocabulary: vocab_path.display().to_string(),
-        superposed_frames: superposed.superposed_frames,
-        kept_frames: superposed.kept_frames,
-        rms_error_from_trajectory_deg: imitated.rms_error_against_deg(trajectory),
-        truth: truth_path.map(|p| p.display().to_string()),
-        upper_body_error_mm: error_mm(&imitated)?,
-        trajectory_playback: Playback {
-            rms_error_deg: played.summary.rms_error_deg,
-            jerk_rms_m_s3: played.summary.jerk_rms_m_s3,
-            upper_body_error_mm: error_mm(&played)?,
-            fell_at_s: played.summary.fell_at_s,
-        },
-    };
-    imitated.summary.primitives = Some(comparison.clone());
     imitated.write(output, &input, 0)?;
     let s = &imitated.summary;
     warn_off_the_floor(&input, s, global);
+    let comparison = s.primitives.as_ref().expect("imitate_run compares");
     let fell = |at: Option<f64>| at.map_or("stayed up".to_string(), |t| format!("fell at {t:.2} s"));
     let off = |mm: Option<f64>| mm.map_or(String::new(), |mm| format!(", {mm:.1} mm from the truth"));
     note(

@@ -19,9 +19,14 @@
 //! standing (the trajectory played: 28.5 mm) and 16.4 mm on a fixed base
 //! (14.0 mm).
 
+use super::execute::{ExecuteError, Execution, Playback, PrimitivesImitation, ValidExecuteParams, execute};
 use crate::mocap::body::JointVector;
 use crate::mocap::pose::{Motion, Pose};
-use crate::vocab::vocabulary::Vocabulary;
+use crate::report::metrics::{ReportError, motion_error_mm};
+use crate::report::read_track;
+use crate::report::run::Run;
+use crate::vocab::vocabulary::{VocabError, Vocabulary};
+use std::path::{Path, PathBuf};
 
 /// How far each frame's superposed pose is drawn toward the run's estimate.
 const SEEN_SHARE: f64 = 0.5;
@@ -100,6 +105,92 @@ pub fn superpose(
         superposed_frames,
         kept_frames: frames - superposed_frames,
     })
+}
+
+/// Why a run could not be imitated by its primitives.
+#[derive(Debug, thiserror::Error)]
+pub enum ImitateError {
+    #[error(transparent)]
+    Report(#[from] ReportError),
+    #[error("{summary}: a --baseline run recognizes no primitives, so none can imitate it")]
+    Baseline { summary: String },
+    #[error("{summary} names the vocabulary {vocabulary}, which cannot be read: {source}")]
+    Vocabulary { summary: String, vocabulary: String, source: VocabError },
+    #[error(
+        "{summary}: the run was tracked with a vocabulary of checksum {tracked}, but {vocabulary} is {found} now: \
+         a run of another vocabulary"
+    )]
+    Checksum { summary: String, vocabulary: String, tracked: String, found: String },
+    #[error("{run} against {vocabulary}: {source}")]
+    Superpose { run: String, vocabulary: String, source: SuperposeError },
+    #[error("{truth}: {frames} frames, but the run has {run}")]
+    Truth { truth: String, frames: usize, run: usize },
+    #[error("{input}: {source}")]
+    Execute { input: String, source: ExecuteError },
+}
+
+/// `execute --primitives`: the run in `run_dir` (its `trajectory` already
+/// read) re-made by its vocabulary's primitives and played with `params`,
+/// its summary's `primitives` block setting it beside the trajectory
+/// played as it is, both scored against `truth` (a truth.csv) when given.
+/// `progress` hears of every frame of both.
+pub fn imitate_run(
+    run_dir: &Path,
+    trajectory: &Motion,
+    truth: Option<&Path>,
+    params: &ValidExecuteParams,
+    mut progress: impl FnMut(),
+) -> Result<Execution, ImitateError> {
+    let run = Run::read(run_dir)?;
+    let summary = run_dir.join("summary.json").display().to_string();
+    if run.summary.baseline.is_some() {
+        return Err(ImitateError::Baseline { summary });
+    }
+    let vocab_path = PathBuf::from(&run.summary.vocabulary.path);
+    let vocab_name = vocab_path.display().to_string();
+    let vocabulary = Vocabulary::load(&vocab_path).map_err(|source| ImitateError::Vocabulary {
+        summary: summary.clone(),
+        vocabulary: vocab_name.clone(),
+        source,
+    })?;
+    if let (Some(tracked), Some(found)) = (&run.summary.vocabulary.checksum, vocabulary.checksum())
+        && *tracked != format!("{found:08x}")
+    {
+        let (tracked, found) = (tracked.clone(), format!("{found:08x}"));
+        return Err(ImitateError::Checksum { summary, vocabulary: vocab_name, tracked, found });
+    }
+    let truth_track = truth.map(read_track).transpose()?;
+    let probabilities: Vec<Vec<Option<f64>>> = run.probabilities.iter().map(|(_, p)| p.clone()).collect();
+    let superposed = superpose(trajectory, &vocabulary, &run.names(), &probabilities).map_err(|source| {
+        ImitateError::Superpose { run: run_dir.display().to_string(), vocabulary: vocab_name.clone(), source }
+    })?;
+    let input = run_dir.join("trajectory.bvh").display().to_string();
+    let failed = |source| ImitateError::Execute { input: input.clone(), source };
+    let played = execute(trajectory, params, &mut progress).map_err(failed)?;
+    let mut imitated = execute(&superposed.motion, params, &mut progress).map_err(failed)?;
+    let error_mm = |execution: &Execution| {
+        let Some(truth) = &truth_track else { return Ok(None) };
+        let done = execution.motion();
+        let frames = (truth.joints.len(), done.poses.len());
+        let mm = motion_error_mm(&done, truth, 1);
+        mm.map(Some).ok_or(ImitateError::Truth { truth: truth.file.clone(), frames: frames.0, run: frames.1 })
+    };
+    imitated.summary.primitives = Some(PrimitivesImitation {
+        run: run_dir.display().to_string(),
+        vocabulary: vocab_name,
+        superposed_frames: superposed.superposed_frames,
+        kept_frames: superposed.kept_frames,
+        rms_error_from_trajectory_deg: imitated.rms_error_against_deg(trajectory),
+        truth: truth.map(|p| p.display().to_string()),
+        upper_body_error_mm: error_mm(&imitated)?,
+        trajectory_playback: Playback {
+            rms_error_deg: played.summary.rms_error_deg,
+            jerk_rms_m_s3: played.summary.jerk_rms_m_s3,
+            upper_body_error_mm: error_mm(&played)?,
+            fell_at_s: played.summary.fell_at_s,
+        },
+    });
+    Ok(imitated)
 }
 
 #[cfg(test)]
