@@ -7,17 +7,19 @@
 //!
 //! Each frame, the imitation's own pose of the frame before is projected
 //! into every primitive's latent space (eq. 3) and carried one frame along
-//! its field, at the latent pace it moved there over the frame before (its
-//! median training pace at the start); the superposed pose moves by the
+//! its field, at the latent pace the person was seen moving at over the
+//! frame before (its median training pace at the start); the superposed
+//! pose moves by the
 //! weighted sum of those moves, then `SEEN_SHARE` of the way to the run's
 //! estimate of the frame before, so it neither drifts off what was seen
 //! nor copies the estimate's frame-to-frame noise. Nothing comes from the
 //! frame being predicted. Measured on the demo's run (`execute
-//! --primitives`): moving by the primitives alone from the estimate
-//! (share 1) left the jerk 1.3× the trajectory's; ½ brought it to 0.4×,
-//! with the upper body's root-relative error against the truth 23.9 mm
-//! standing (the trajectory played: 28.5 mm) and 16.4 mm on a fixed base
-//! (14.0 mm).
+//! --primitives --truth`): the jerk 0.52× the trajectory played's
+//! standing, the upper body's root-relative error against the truth 22.8
+//! mm (the trajectory played: 28.5 mm), on a fixed base 15.6 mm (14.0 mm).
+//! Moving by the primitives from the estimate with no pull toward it (an
+//! earlier version, which also measured the pace between the imitation and
+//! the estimate) left the jerk 1.3× the trajectory's.
 
 use super::execute::{ExecuteError, Execution, Playback, PrimitivesImitation, ValidExecuteParams, execute};
 use crate::mocap::body::JointVector;
@@ -83,9 +85,11 @@ pub fn superpose(
         let mut x: JointVector = poses[k - 1].x;
         for (primitive, &w) in primitives.iter().zip(&weights).filter(|(_, w)| **w > 0.0) {
             let at = primitive.project(&poses[k - 1].x);
+            // The pace the person was seen moving at, in this primitive's
+            // latent space.
             let pace = (k >= 2).then(|| {
-                let before = primitive.project(&trajectory.poses[k - 2].x);
-                at.iter().zip(&before).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt() / dt
+                let [seen, before] = [k - 1, k - 2].map(|f| primitive.project(&trajectory.poses[f].x));
+                seen.iter().zip(&before).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt() / dt
             });
             let Some(next) = primitive.predict(&at, 1, dt, pace).pop() else { continue };
             let (from, to) = (primitive.reconstruct(&at), primitive.reconstruct(&next));

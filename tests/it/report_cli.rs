@@ -212,12 +212,12 @@ fn the_primitives_imitate_a_run_more_smoothly_than_its_trajectory_and_refuse_ano
         (s["jerk_rms_m_s3"].as_f64().unwrap(), p["trajectory_playback"]["jerk_rms_m_s3"].as_f64().unwrap());
     assert!(jerk < played, "jerk {jerk} against {played} m/s³");
     assert!(p["rms_error_from_trajectory_deg"].as_f64().unwrap() < 15.0, "{p}");
-    // Both are scored against the truth (docs/numbers.md has the figures:
-    // this wave-h on a fixed base is 1.21× the trajectory's error).
+    // Both are scored against the truth: within 1.2× of the trajectory
+    // played (measured 1.11×; docs/commands.md has the demo's figures).
     let (mine, theirs) =
         (p["upper_body_error_mm"].as_f64().unwrap(), p["trajectory_playback"]["upper_body_error_mm"].as_f64().unwrap());
     eprintln!("primitives {mine:.1} mm, trajectory {theirs:.1} mm; jerk {jerk:.1} against {played:.1} m/s³");
-    assert!(mine > 0.0 && theirs > 0.0 && p["truth"] == "video/truth.csv", "{p}");
+    assert!(mine > 0.0 && mine <= 1.2 * theirs && p["truth"] == "video/truth.csv", "{p}");
 
     // A run of another vocabulary, a baseline run, both a trajectory and a run.
     let summary = fs::read_to_string(dir.join("run/summary.json")).unwrap();
