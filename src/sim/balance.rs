@@ -113,20 +113,25 @@ impl Humanoid {
             (self.world.bodies[self.links[Joint::Pelvis.index()]].translation().as_dvec3().y - support.y).max(0.1);
         let turn = DQuat::from_scaled_axis((DVec3::Y.cross(shift) / hip_height).clamp_length_max(BALANCE_MAX_RAD));
         for k in (0..2).filter(|&k| self.stands(FEET[k])) {
-            let (foot, hip) = (FEET[k], HIPS[k]);
-            let shank = self.rotation(foot.parent().expect("only the pelvis has no parent"));
-            // The shank turned by `turn` in the world over a foot that stays
-            // whose sole is asked halfway between where the trajectory
-            // turns it and flat where it stands (`PLANTED_SHARE`),
-            let sole = self.rotation(foot);
-            let flat = DQuat::from_rotation_arc(sole * DVec3::Y, DVec3::Y) * sole;
-            let ankle = &mut targets[foot.index()];
-            let asked = (shank * ankle.rotation).slerp(flat, PLANTED_SHARE);
-            ankle.rotation = clamp(foot, shank.inverse() * turn.inverse() * asked).0;
-            // and the thigh with it under a pelvis that stays.
-            let thigh = &mut targets[hip.index()];
+            // The shank turned by `turn` in the world over a foot that
+            // stays, and the thigh with it under a pelvis that stays.
+            self.plant(targets, k, turn);
+            let (hip, thigh) = (HIPS[k], &mut targets[HIPS[k].index()]);
             thigh.rotation = clamp(hip, pelvis.inverse() * turn * pelvis * thigh.rotation).0;
         }
+    }
+
+    /// Asks standing foot `k`'s sole to stay halfway between where the
+    /// trajectory turns it and flat where it stands (`PLANTED_SHARE`) while
+    /// its shank turns by `turn` in the world.
+    pub(super) fn plant(&self, targets: &mut [JointTarget; JOINTS], k: usize, turn: DQuat) {
+        let foot = FEET[k];
+        let shank = self.rotation(foot.parent().expect("only the pelvis has no parent"));
+        let sole = self.rotation(foot);
+        let flat = DQuat::from_rotation_arc(sole * DVec3::Y, DVec3::Y) * sole;
+        let ankle = &mut targets[foot.index()];
+        let asked = (shank * ankle.rotation).slerp(flat, PLANTED_SHARE);
+        ankle.rotation = clamp(foot, shank.inverse() * turn.inverse() * asked).0;
     }
 }
 

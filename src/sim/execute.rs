@@ -5,6 +5,7 @@
 use super::anthropometry::body_mass_kg;
 use super::assist::Wrench;
 use super::humanoid::{Base, GRAVITY_M_S2, Gains, Humanoid};
+use super::stepping::Contacts;
 use super::targets::{JointTarget, Targets, TargetsError, motorized};
 use crate::fsutil::{WriteError, round6, rounded, rounded_option, write_atomic, write_dir_atomic};
 use crate::mocap::body::{JOINTS, Joint, Kind};
@@ -12,7 +13,7 @@ use crate::mocap::bvh::write_bvh;
 use crate::mocap::math::angle_between;
 use crate::mocap::pose::{BodyFrame, Motion, Pose};
 use crate::params::{InvalidField, Params};
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 use std::fmt::Write;
 use std::io::Write as _;
 use std::path::Path;
@@ -299,8 +300,10 @@ pub fn execute(
 ) -> Result<Execution, ExecuteError> {
     let ExecuteParams { base, balance, assist, gains, rate_hz } = params.0;
     let balance = balance && base == Base::Free;
+    // The feet's contacts do not depend on how the feet are turned.
+    let contacts = Contacts::of(motion);
     let (levelled, feet_levelled_rad) = match base {
-        Base::Free => level_feet(motion),
+        Base::Free => contacts.level_feet(motion),
         Base::Fixed => (motion.clone(), [0.0; 2]),
     };
     let motion = &levelled;
@@ -321,6 +324,9 @@ pub fn execute(
     let mut frames = Vec::with_capacity(targets.frames());
     // Where the humanoid's pelvis was put against the trajectory's.
     let offset = humanoid.frame().position(Joint::Pelvis) - targets.pose(0).root;
+    if base == Base::Free {
+        humanoid.launch(targets.root_at(0.0).velocity);
+    }
     if assist {
         humanoid.attach_assist();
     }
@@ -344,7 +350,10 @@ pub fn execute(
             targets.sample(time_s, &mut asked);
             if balance {
                 let wanted = asked;
-                humanoid.balance(&mut asked);
+                match contacts.single_stance(time_s) {
+                    Some((stance, ankle)) => humanoid.step_over(&mut asked, stance, ankle, &targets.root_at(time_s)),
+                    None => humanoid.balance(&mut asked),
+                }
                 departure_rad = motorized()
                     .map(|j| angle_between(wanted[j.index()].rotation, asked[j.index()].rotation))
                     .fold(0.0, f64::max);
@@ -442,45 +451,6 @@ pub fn execute(
         joints,
     };
     Ok(Execution { targets, frames, summary, body: motion.body.clone() })
-}
-
-/// A foot stands at the start when its ankle is within this of the lower
-/// ankle's height and its sole is tilted less than [`LEVEL_MAX_RAD`].
-const STANDING_FOOT_M: f64 = 0.05;
-const LEVEL_MAX_RAD: f64 = std::f64::consts::FRAC_PI_3;
-
-/// `motion` with each foot that stands at the start turned, for the whole
-/// take, by the constant rotation that lays its sole flat on the floor in
-/// the first frame, and by how much each was turned (left, right;
-/// radians). A captured foot runs from the ankle to the ball of the foot,
-/// steeper than the canonical foot's ankle to toe tip, so a retargeted
-/// person standing flat stands on the canonical body's toes (15–30° on the
-/// real captures). A foot higher than the other, or tilted further (a
-/// retargeting failure, not a stance), is left alone.
-fn level_feet(motion: &Motion) -> (Motion, [f64; 2]) {
-    let mut out = motion.clone();
-    let mut turned = [0.0; 2];
-    let Some(first) = motion.poses.first() else { return (out, turned) };
-    let frame = motion.body.forward(first);
-    let feet = [Joint::LeftAnkle, Joint::RightAnkle];
-    let lower = feet.iter().map(|&f| frame.position(f).y).fold(f64::INFINITY, f64::min);
-    for (k, foot) in feet.into_iter().enumerate() {
-        let world = frame.rotation(foot);
-        let sole = world * DVec3::Y;
-        let tilt = sole.angle_between(DVec3::Y);
-        if frame.position(foot).y > lower + STANDING_FOOT_M || tilt > LEVEL_MAX_RAD {
-            continue;
-        }
-        // In the foot's own frame, so it rides along with the ankle.
-        let correction = world.inverse() * DQuat::from_rotation_arc(sole, DVec3::Y) * world;
-        for pose in &mut out.poses {
-            let mut local = Joint::ALL.map(|j| pose.local_rotation(j));
-            local[foot.index()] *= correction;
-            *pose = Pose::from_rotations(pose.root, &local);
-        }
-        turned[k] = tilt;
-    }
-    (out, turned)
 }
 
 /// The RMS of every joint's third derivative of position over `poses`,
@@ -701,6 +671,7 @@ fn numbers(j: Joint) -> Vec<String> {
 mod tests {
     use super::*;
     use crate::mocap::body::Body;
+    use glam::DQuat;
     use std::f64::consts::FRAC_PI_3;
 
     /// The standard body bowing: spine and chest each bent forward by

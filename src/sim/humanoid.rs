@@ -272,6 +272,20 @@ impl Humanoid {
         }
     }
 
+    /// Sets the whole body moving by `velocity` (m/s) on top of how its
+    /// joints move it, as the trajectory's pelvis moves at its start: a
+    /// walk started from rest would have to be begun by legs that are
+    /// already mid-stride.
+    pub fn launch(&mut self, velocity: DVec3) {
+        for &link in &self.links {
+            let rigid = &mut self.world.bodies[link];
+            if rigid.is_dynamic() {
+                let moving = rigid.linvel() + velocity.as_vec3();
+                rigid.set_linvel(moving, true);
+            }
+        }
+    }
+
     pub(super) fn rotation(&self, j: Joint) -> DQuat {
         to_f64(*self.world.bodies[self.links[j.index()]].rotation())
     }

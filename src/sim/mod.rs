@@ -7,5 +7,6 @@ pub mod assist;
 pub mod balance;
 pub mod execute;
 pub mod humanoid;
+pub mod stepping;
 pub mod superpose;
 pub mod targets;

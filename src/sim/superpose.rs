@@ -9,10 +9,9 @@
 //! into every primitive's latent space (eq. 3) and carried one frame along
 //! its field, at the latent pace the person was seen moving at over the
 //! frame before (its median training pace at the start); the superposed
-//! pose moves by the
-//! weighted sum of those moves, then `SEEN_SHARE` of the way to the run's
-//! estimate of the frame before, so it neither drifts off what was seen
-//! nor copies the estimate's frame-to-frame noise. Nothing comes from the
+//! pose moves by the weighted sum of those moves, then `SEEN_SHARE` of the
+//! way to the run's estimate of the frame before, so it neither drifts
+//! off what was seen nor copies the estimate's frame-to-frame noise. Nothing comes from the
 //! frame being predicted. Measured on the demo's run (`execute
 //! --primitives --truth`): the jerk 0.52× the trajectory played's
 //! standing, the upper body's root-relative error against the truth 22.8

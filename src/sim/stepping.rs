@@ -1,0 +1,212 @@
+//! Stepping: while the take stands on one foot, the humanoid's swing foot
+//! is placed where its balance needs it and its stance hip holds the trunk
+//! up (after SIMBICON, Yin et al. 2007, with the take as the reference
+//! rather than a hand-made gait, as in data-driven biped control).
+
+use super::humanoid::{FEET, GRAVITY_M_S2, HIPS, Humanoid};
+use super::targets::{JointTarget, RootTarget, clamp};
+use crate::mocap::body::{JOINTS, Joint};
+use crate::mocap::pose::{Motion, Pose};
+use glam::{DQuat, DVec3};
+
+/// A foot of the take stands while its ankle is within this of the height
+/// it stands at ...
+const CONTACT_RISE_M: f64 = 0.04;
+/// ... and it moves slower than this.
+const CONTACT_SPEED_M_S: f64 = 0.6;
+/// The share of the frames whose ankle is at or below the height it is
+/// taken to stand at (a take may crouch or jump in places).
+const STANDING_QUANTILE: f64 = 0.1;
+/// An ankle whose standing height is this far above the other's is held
+/// up, not standing.
+const LIFTED_M: f64 = 0.15;
+/// A sole tilted further than this on a frame the take stands on it is a
+/// retargeting failure, not a stance, and does not count.
+const LEVEL_MAX_RAD: f64 = std::f64::consts::FRAC_PI_3;
+/// The most the swing leg is turned to place its foot.
+const PLACEMENT_MAX_RAD: f64 = 0.5;
+
+/// Which of the take's feet stand, frame by frame, and where its ankles
+/// are.
+#[derive(Clone, Debug)]
+pub struct Contacts {
+    frame_time_s: f64,
+    standing: Vec<[bool; 2]>,
+    ankles: Vec<[DVec3; 2]>,
+}
+
+impl Contacts {
+    /// The contacts of `motion`'s feet, from its ankles' heights and
+    /// speeds.
+    pub fn of(motion: &Motion) -> Contacts {
+        let ankles: Vec<[DVec3; 2]> = motion
+            .poses
+            .iter()
+            .map(|p| {
+                let frame = motion.body.forward(p);
+                FEET.map(|f| frame.position(f))
+            })
+            .collect();
+        // Each foot's own: a retargeted take may hold one ankle a few
+        // centimetres higher than the other throughout (measured on bandai:
+        // standing gestures read as standing on one foot against the
+        // lower ankle's height).
+        let [left, right] = [0, 1].map(|f| {
+            let mut heights: Vec<f64> = ankles.iter().map(|a| a[f].y).collect();
+            heights.sort_by(f64::total_cmp);
+            heights.get((STANDING_QUANTILE * heights.len() as f64) as usize).copied().unwrap_or(0.0)
+        });
+        // A foot held up the whole take does not stand at its lowest.
+        let standing_y = [left.min(right + LIFTED_M), right.min(left + LIFTED_M)];
+        let dt = motion.frame_time_s;
+        let last = ankles.len().saturating_sub(1);
+        let standing = (0..ankles.len())
+            .map(|k| {
+                let (before, after) = (k.saturating_sub(1), (k + 1).min(last));
+                [0, 1].map(|f| {
+                    let travel = ankles[after][f] - ankles[before][f];
+                    let speed = DVec3::new(travel.x, 0.0, travel.z).length() / (dt * (after - before).max(1) as f64);
+                    ankles[k][f].y < standing_y[f] + CONTACT_RISE_M && speed < CONTACT_SPEED_M_S
+                })
+            })
+            .collect();
+        Contacts { frame_time_s: dt, standing, ankles }
+    }
+
+    /// The one foot the take stands on at `time_s` (0 left, 1 right) and
+    /// where its ankle is; `None` while it stands on both or neither.
+    pub fn single_stance(&self, time_s: f64) -> Option<(usize, DVec3)> {
+        let at = (time_s / self.frame_time_s).max(0.0);
+        let last = self.standing.len() - 1;
+        let foot = match self.standing[(at.round() as usize).min(last)] {
+            [true, false] => 0,
+            [false, true] => 1,
+            _ => return None,
+        };
+        let (a, b) = ((at.floor() as usize).min(last), (at.floor() as usize + 1).min(last));
+        Some((foot, self.ankles[a][foot].lerp(self.ankles[b][foot], at - at.floor())))
+    }
+
+    /// `motion` with each foot turned, for the whole take, by the constant
+    /// rotation (in the foot's own frame) that lays its sole flat on the
+    /// first frame the take stands on it, and by how much each was
+    /// turned (left, right; radians). A captured foot runs from the ankle
+    /// to the ball of the foot, steeper than the canonical foot's ankle to
+    /// toe tip, so a retargeted person standing flat stands on the
+    /// canonical body's toes (15–30° on the real captures), and a walk
+    /// lands on them. A foot the take never stands on is left alone.
+    pub fn level_feet(&self, motion: &Motion) -> (Motion, [f64; 2]) {
+        let mut out = motion.clone();
+        let mut turned = [0.0; 2];
+        for (k, foot) in FEET.into_iter().enumerate() {
+            let first_stance = motion.poses.iter().zip(&self.standing).find_map(|(pose, s)| {
+                let world = motion.body.forward(pose).rotation(foot);
+                let sole = world * DVec3::Y;
+                (s[k] && sole.angle_between(DVec3::Y) <= LEVEL_MAX_RAD)
+                    .then(|| world.inverse() * DQuat::from_rotation_arc(sole, DVec3::Y) * world)
+            });
+            let Some(correction) = first_stance else { continue };
+            for pose in &mut out.poses {
+                let mut local = Joint::ALL.map(|j| pose.local_rotation(j));
+                local[foot.index()] *= correction;
+                *pose = Pose::from_rotations(pose.root, &local);
+            }
+            turned[k] = correction.angle_between(DQuat::IDENTITY);
+        }
+        (out, turned)
+    }
+}
+
+impl Humanoid {
+    /// Turns `targets` so that, while the take stands on foot `stance`
+    /// (whose ankle is at `take_ankle`, the take's pelvis as `root` says),
+    /// the humanoid's swing foot lands where its capture point needs it:
+    /// the take's own placement moved by as far as the humanoid's capture
+    /// point, taken from the stance ankle, is off the take's (a gain of 1:
+    /// 0 to 1.5 on either of its terms kept the walks up alike), its sole
+    /// held flat in the world. A standing stance foot's hip
+    /// turns the pelvis to the take's rotation in the world, whatever the
+    /// leg beneath does, and its sole is laid halfway to flat as
+    /// [`Humanoid::balance`] does.
+    pub fn step_over(&self, targets: &mut [JointTarget; JOINTS], stance: usize, take_ankle: DVec3, root: &RootTarget) {
+        let swing = 1 - stance;
+        let frame = self.frame();
+        let pelvis = frame.rotation(Joint::Pelvis);
+        let height = (frame.position(Joint::Pelvis).y - frame.position(FEET[stance]).y).max(0.1);
+        let omega = (GRAVITY_M_S2 / height).sqrt();
+        let flat = |v: DVec3| DVec3::new(v.x, 0.0, v.z);
+        let velocity = self.world.bodies[self.links[Joint::Pelvis.index()]].linvel().as_dvec3();
+        let off = flat(frame.position(Joint::Pelvis) - frame.position(FEET[stance]) - (root.position - take_ankle))
+            + flat(velocity - root.velocity) / omega;
+        let (hip, knee, ankle) = (HIPS[swing], FEET[swing].parent().expect("a foot has a shank"), FEET[swing]);
+        let leg = (frame.position(hip) - frame.position(ankle)).length().max(0.1);
+        // Turning the leg by θ about its hip moves its foot, `leg` below,
+        // by θ × (−Y·leg); θ = off × Y / leg moves it by `off`.
+        let turn = DQuat::from_scaled_axis((off.cross(DVec3::Y) / leg).clamp_length_max(PLACEMENT_MAX_RAD));
+        let thigh = root.rotation * targets[hip.index()].rotation;
+        let shank = thigh * targets[knee.index()].rotation;
+        let sole = shank * targets[ankle.index()].rotation;
+        // Flat, so that its toe does not catch the ground: the canonical
+        // foot is longer than a captured ankle-to-ball foot.
+        let sole = DQuat::from_rotation_arc(sole * DVec3::Y, DVec3::Y) * sole;
+        targets[hip.index()].rotation = clamp(hip, pelvis.inverse() * turn * thigh).0;
+        targets[ankle.index()].rotation = clamp(ankle, (turn * shank).inverse() * sole).0;
+        if self.stands(FEET[stance]) {
+            let thigh = frame.rotation(HIPS[stance]);
+            targets[HIPS[stance].index()].rotation = clamp(HIPS[stance], root.rotation.inverse() * thigh).0;
+            self.plant(targets, stance, DQuat::IDENTITY);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mocap::body::Body;
+
+    /// The standard body standing, with the feet `lifted` (left, right)
+    /// off the ground by a bent hip and knee and every sole turned 20°
+    /// toe-down.
+    fn stance(body: &Body, lifted: [bool; 2]) -> Pose {
+        let mut local = [DQuat::IDENTITY; JOINTS];
+        for (k, foot) in FEET.into_iter().enumerate() {
+            local[foot.index()] = DQuat::from_rotation_x(20f64.to_radians());
+            if lifted[k] {
+                local[HIPS[k].index()] = DQuat::from_rotation_x(-0.8);
+                local[foot.parent().unwrap().index()] = DQuat::from_rotation_x(1.5);
+            }
+        }
+        Pose::from_rotations(Pose::rest(body).root, &local)
+    }
+
+    fn motion(phases: &[[bool; 2]]) -> Motion {
+        let body = Body::standard();
+        let poses = phases.iter().flat_map(|&lifted| std::iter::repeat_n(stance(&body, lifted), 10)).collect();
+        Motion { body, frame_time_s: 1.0 / 30.0, poses }
+    }
+
+    #[test]
+    fn the_take_stands_on_the_foot_that_is_down_and_a_foot_held_up_throughout_never_stands() {
+        let take = motion(&[[false, false], [true, false], [false, false], [false, true]]);
+        let contacts = Contacts::of(&take);
+        let at = |k: usize| contacts.single_stance(k as f64 * take.frame_time_s).map(|(foot, _)| foot);
+        assert_eq!([at(5), at(15), at(25), at(35)], [None, Some(1), None, Some(0)]);
+        let (_, ankle) = contacts.single_stance(15.0 * take.frame_time_s).unwrap();
+        assert!(ankle.distance(take.body.forward(&take.poses[15]).position(Joint::RightAnkle)) < 1e-12);
+        // Standing on the right leg the whole take.
+        let take = motion(&[[true, false]; 3]);
+        let contacts = Contacts::of(&take);
+        assert!((0..30).all(|k| contacts.single_stance(k as f64 / 30.0).is_some_and(|(foot, _)| foot == 1)));
+    }
+
+    #[test]
+    fn each_foot_is_laid_flat_as_it_first_stands_even_if_it_starts_in_the_air() {
+        let take = motion(&[[true, false], [false, false]]);
+        let (levelled, turned) = Contacts::of(&take).level_feet(&take);
+        for (k, foot) in FEET.into_iter().enumerate() {
+            assert!((turned[k].to_degrees() - 20.0).abs() < 1e-6, "{turned:?}");
+            let sole = levelled.body.forward(&levelled.poses[15]).rotation(foot) * DVec3::Y;
+            assert!(sole.angle_between(DVec3::Y) < 1e-9, "{foot:?}");
+        }
+    }
+}
