@@ -1,5 +1,6 @@
 //! `imitate eval`: the paper's trials, run end to end, as a report.
 
+mod imitation;
 mod mocap;
 mod person;
 mod video;
@@ -207,6 +208,8 @@ struct Video {
     name: String,
     frames: PathBuf,
     truth: PathBuf,
+    /// The take it was filmed from.
+    motion: PathBuf,
 }
 
 impl Work {
@@ -258,7 +261,12 @@ impl Work {
         let (motion, activities) = read_take(bvh, Some(labels), &RetargetOptions::default(), &mut ())?;
         let filming = Filming { build, ..Filming::new(camera) };
         film(&motion, activities.as_deref(), &filming, &out, &|| {}).with_context(|| bvh.display().to_string())?;
-        Ok(Video { name: name.to_string(), frames: out.join("frames"), truth: out.join("truth.csv") })
+        Ok(Video {
+            name: name.to_string(),
+            frames: out.join("frames"),
+            truth: out.join("truth.csv"),
+            motion: bvh.to_path_buf(),
+        })
     }
 
     /// A synthetic take: `--sequence` of `activities` (or one activity's
@@ -507,6 +515,7 @@ fn evaluate(args: &Args, global: Global, dir: &Path) -> anyhow::Result<Outcome> 
     }
     let (mut tables, styles) = mocap::section(&work, &args.mocap)?;
     trials.extend(styles);
+    tables.push(imitation::table(&work, &front.motion, &first, &front.truth, &args.real)?);
     let mut table_timing = Vec::new();
     if let Some(clips) = &args.real_video {
         let vocab = video::mocap_vocabulary(&work, &args.mocap)?;

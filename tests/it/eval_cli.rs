@@ -82,16 +82,33 @@ fn a_quick_evaluation_reports_every_trial_with_the_numbers_of_its_metrics_json()
             }
         }
     }
-    // The real motion capture's tables: their cells on the page, their CSV
-    // a row per metrics.json row.
+    // The tables: their CSV a row per metrics.json row.
+    let tables = metrics["tables"].as_object().unwrap();
+    for (key, rows) in tables {
+        let csv = fs::read_to_string(report.join(format!("{key}.csv"))).unwrap();
+        assert_eq!(csv.lines().count(), rows.as_array().unwrap().len() + 1, "{key}.csv: a row per row");
+    }
+    // Imitation: the synthetic take followed closely on a stand and kept up
+    // on the ground; the tracked run imitated by its primitives within 1.2×
+    // of its trajectory played, and smoother (issue 20).
+    let imitation = tables["imitation"].as_array().unwrap();
+    let (synthetic, tracked) = (&imitation[0], &imitation[1]);
+    let number = |v: &serde_json::Value| v.as_f64().unwrap();
+    assert!(number(&synthetic["fixed_base"]["rms_error_deg"]) < 1.0, "{synthetic}");
+    assert!(synthetic["ground"]["fell_at_s"].is_null(), "{synthetic}");
+    assert!(html.contains(&format!("{:.2}", number(&synthetic["fixed_base"]["rms_error_deg"]))));
+    let primitives = &tracked["primitives"];
+    let (mine, theirs) =
+        (number(&primitives["upper_body_error_mm"]), number(&primitives["trajectory_upper_body_error_mm"]));
+    assert!(mine <= 1.2 * theirs, "{primitives}");
+    assert!(number(&primitives["jerk_rms_m_s3"]) < number(&primitives["trajectory_jerk_rms_m_s3"]), "{primitives}");
+    let labelled =
+        real_mocap_dir().map_or(0, |d| fs::read_to_string(d.join("labels.csv")).unwrap().lines().count() - 1);
+    assert_eq!(imitation.len(), 2 + labelled, "every real take is played");
+    // The real motion capture's tables: their cells on the page.
     if mocap != "absent" {
-        let tables = metrics["tables"].as_object().unwrap();
         let keys: Vec<&str> = tables.keys().map(String::as_str).collect();
-        assert_eq!(keys, ["mocap_corpora", "mocap_held_out", "mocap_projection", "mocap_vocabularies"]);
-        for (key, rows) in tables {
-            let csv = fs::read_to_string(report.join(format!("{key}.csv"))).unwrap();
-            assert_eq!(csv.lines().count(), rows.as_array().unwrap().len() + 1, "{key}.csv: a row per row");
-        }
+        assert_eq!(keys, ["imitation", "mocap_corpora", "mocap_held_out", "mocap_projection", "mocap_vocabularies"]);
         let corpora = tables["mocap_corpora"].as_array().unwrap();
         let all = corpora.last().unwrap();
         assert_eq!(all["corpus"], "all");
@@ -135,7 +152,7 @@ fn a_quick_evaluation_reports_every_trial_with_the_numbers_of_its_metrics_json()
 
     // The same seed gives the same numbers and tables (only timing differs).
     eval("b");
-    for file in ["metrics.json", "particles.csv", "speed.csv", "figure8.svg", "filmstrip-front.png"] {
+    for file in ["metrics.json", "particles.csv", "speed.csv", "imitation.csv", "figure8.svg", "filmstrip-front.png"] {
         let same = fs::read(report.join(file)).unwrap() == fs::read(dir.join("b").join(file)).unwrap();
         assert!(same, "{file} differs between two runs of the same seed");
     }
