@@ -173,7 +173,8 @@ def execute(
     ankles to the trajectory; ``gains`` are the motors' stiffness and
     damping (KP 1/s², KD 1/s); ``rate`` the physics steps a second;
     ``skip`` leaves out the first frames (by default the first one when it
-    is a bind pose, as ``imitate execute`` does; ``skip=0`` keeps it);
+    is a bind pose, as ``imitate execute`` does, with a ``UserWarning``;
+    ``skip=0`` keeps it; a first frame off the floor is warned of too);
     ``assist`` pulls the pelvis toward the trajectory's with a residual
     force and torque, reported in the table (``assist_force_n``,
     ``assist_torque_nm``). With ``primitives`` (a ``track`` run folder, in

@@ -2,7 +2,7 @@
 //! read as silhouettes, whole clips tracked (`track`), runs scored
 //! (`score`) and trajectories played on the humanoid (`execute`).
 
-use crate::motion::{Motion, shape_error};
+use crate::motion::{Motion, shape_error, warn};
 use crate::vocab::{Vocabulary, vocab_failure};
 use crate::{Class, Options, failure, pool_of, raise, run_on};
 use glam::DVec3;
@@ -702,7 +702,7 @@ pub fn execute_table(
         return Err(raise(Class::Options, "truth: scores an imitation by the primitives only".to_string(), None));
     }
     let mut trajectory = motion.motion.clone();
-    let Some((skip, _)) = frames_to_skip(&trajectory, skip.or(primitives.as_ref().map(|_| 0))) else {
+    let Some((skip, bind_pose)) = frames_to_skip(&trajectory, skip.or(primitives.as_ref().map(|_| 0))) else {
         let (asked, frames) = (skip.unwrap_or(0), trajectory.poses.len());
         return Err(raise(Class::Options, format!("skip: {asked}: {} has only {frames} frames", motion.source), None));
     };
@@ -718,6 +718,15 @@ pub fn execute_table(
             .detach(|| execute(&trajectory, &params, || {}))
             .map_err(|e| raise(Class::Error, format!("{}: {}", motion.source, imitate::describe(&e)), None))?,
     };
+    let mut warnings = Vec::new();
+    if let Some(bind_pose) = bind_pose {
+        warnings.push(format!(
+            "{}: the first frame is left out as a bind pose ({bind_pose}); skip=0 keeps it",
+            motion.source
+        ));
+    }
+    warnings.extend(execution.summary.off_the_floor().map(|w| format!("{}: warning: {w}", motion.source)));
+    warn(py, &warnings)?;
     if let Some(out) = &out {
         execution.write(out, &motion.source, skip).map_err(|e| failure(Class::Error, &e, Some(e.path.clone())))?;
     }

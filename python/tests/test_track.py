@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -13,7 +14,7 @@ import polars as pl
 import pytest
 
 import imitate
-from conftest import read_csv
+from conftest import read_csv, shared
 
 
 def test_track_returns_exactly_the_cli_frames_csv(tmp_path, clip, run_dir):
@@ -204,3 +205,19 @@ def test_trackers_in_threads_give_what_each_gives_alone(clip):
     # A tracker on a pool of one thread of its own follows the same way.
     tracker = imitate.Tracker("vocab/default.vocab", camera, seed=1, threads=1)
     assert np.array_equal(np.stack([tracker.step(silhouette=m).joints for m in masks]), alone[0])
+
+
+def test_execute_warns_of_a_left_out_bind_pose_and_of_a_start_in_the_air(tmp_path):
+    with pytest.warns(UserWarning, match=r"boxing\.bvh: the first frame is left out as a bind pose .*skip=0 keeps it"):
+        imitate.execute(shared("mocap", "real", "boxing.bvh"), fixed_base=True)
+    # The punch with its root raised half a metre on every frame.
+    lines = Path("mocap/punch.bvh").read_text().splitlines()
+    start = lines.index("MOTION") + 3
+    for k in range(start, len(lines)):
+        values = lines[k].split()
+        values[1] = f"{float(values[1]) + 0.5:.6f}"
+        lines[k] = " ".join(values)
+    raised = tmp_path / "raised.bvh"
+    raised.write_text("\n".join(lines) + "\n")
+    with pytest.warns(UserWarning, match=r"raised\.bvh: warning: the first frame's lowest point lies 0\.50 m above"):
+        imitate.execute(raised)

@@ -79,29 +79,13 @@ pub struct Args {
     pub force: bool,
 }
 
-/// A first frame whose lowest point lies further than this from the floor
-/// is said to start in the air or under it (the real captures start within
-/// 8 cm, their skeletons' feet unlike the canonical body's).
-const OFF_THE_FLOOR_M: f64 = 0.10;
-
-/// Warns when the trajectory `input` started off the floor (`summary`'s
-/// `start_raised_m`).
+/// Warns when the trajectory `input` started off the floor.
 fn warn_off_the_floor(input: &str, summary: &Summary, global: Global) {
-    let raised = summary.start_raised_m;
-    if raised.abs() > OFF_THE_FLOOR_M {
-        let (by, where_) =
-            if raised < 0.0 { (-raised, "above the floor (in the air)") } else { (raised, "below the floor") };
-        note(
-            global,
-            &format!(
-                "{input}: warning: the first frame's lowest point lies {by:.2} m {where_}; the humanoid started \
-                 standing on it"
-            ),
-        );
+    if let Some(warning) = summary.off_the_floor() {
+        note(global, &format!("{input}: warning: {warning}"));
     }
 }
 
-/// `KP,KD`.
 fn parse_gains(text: &str) -> Result<Gains, UsageError> {
     let bad = || UsageError(format!("--gains {text}: expected KP,KD, two positive numbers, e.g. 10000,200"));
     let (kp, kd) = text.split_once(',').ok_or_else(bad)?;

@@ -291,6 +291,24 @@ pub struct JointSummary {
 const FALLEN_PELVIS_SHARE: f64 = 0.5;
 const FALLEN_LEAN_RAD: f64 = std::f64::consts::FRAC_PI_4;
 
+/// A first frame whose lowest point lies further than this from the floor
+/// is said to start in the air or under it (the real captures start within
+/// 8 cm, their skeletons' feet unlike the canonical body's).
+const OFF_THE_FLOOR_M: f64 = 0.10;
+
+impl Summary {
+    /// What to warn of when the first frame lay off the floor (in the air
+    /// or under it): the humanoid was started standing on it.
+    pub fn off_the_floor(&self) -> Option<String> {
+        let raised = self.start_raised_m;
+        (raised.abs() > OFF_THE_FLOOR_M).then(|| {
+            let (by, where_) =
+                if raised < 0.0 { (-raised, "above the floor (in the air)") } else { (raised, "below the floor") };
+            format!("the first frame's lowest point lies {by:.2} m {where_}; the humanoid started standing on it")
+        })
+    }
+}
+
 /// Plays `motion` on the humanoid of its body. `progress` hears of every
 /// frame done.
 pub fn execute(
