@@ -15,11 +15,21 @@ use imitate::vocab::learn::read_take;
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 
-/// A take to play: its row's name, its activity, its BVH.
+/// A take to play: its row's name, its activity, its BVH, and where it
+/// comes from.
 struct Take {
     name: String,
     activity: String,
     bvh: PathBuf,
+    source: Source,
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Source {
+    Synthetic,
+    /// Trial one's run: also imitated by its primitives.
+    Tracked,
+    Real,
 }
 
 /// The three ways every take is played: on a stand, on the ground, and on
@@ -39,8 +49,18 @@ fn settings() -> anyhow::Result<[ValidExecuteParams; 3]> {
 /// one), each as `imitate execute` does by default.
 pub(super) fn table(work: &Work, synthetic: &Path, run: &Path, truth: &Path, real: &Path) -> anyhow::Result<Table> {
     let mut takes = vec![
-        Take { name: "synthetic sequence".into(), activity: "circles, wave-h, wave-v".into(), bvh: synthetic.into() },
-        Take { name: "its tracked trajectory".into(), activity: "(tracked)".into(), bvh: run.join("trajectory.bvh") },
+        Take {
+            name: "synthetic sequence".into(),
+            activity: "circles, wave-h, wave-v".into(),
+            bvh: synthetic.into(),
+            source: Source::Synthetic,
+        },
+        Take {
+            name: "its tracked trajectory".into(),
+            activity: "(tracked)".into(),
+            bvh: run.join("trajectory.bvh"),
+            source: Source::Tracked,
+        },
     ];
     let labels = real.join("labels.csv");
     if labels.is_file() {
@@ -48,13 +68,18 @@ pub(super) fn table(work: &Work, synthetic: &Path, run: &Path, truth: &Path, rea
         for line in text.lines().skip(1).filter(|l| !l.trim().is_empty()) {
             let mut fields = line.split(',');
             let (Some(file), Some(activity)) = (fields.next(), fields.next()) else { continue };
-            takes.push(Take { name: file.into(), activity: activity.into(), bvh: real.join(file) });
+            takes.push(Take {
+                name: file.into(),
+                activity: activity.into(),
+                bvh: real.join(file),
+                source: Source::Real,
+            });
         }
     }
     let settings = settings()?;
     let (mut rows, mut metrics) = (Vec::new(), Vec::new());
     let (mut real_up, mut real_assisted_up, mut real_played) = (0, 0, 0);
-    for (k, take) in takes.iter().enumerate() {
+    for take in &takes {
         work.step(&format!("imitation: {}", take.name));
         let shown = take.bvh.display().to_string();
         let (mut motion, _) = read_take(&take.bvh, None, &RetargetOptions::default(), &mut ())?;
@@ -65,7 +90,7 @@ pub(super) fn table(work: &Work, synthetic: &Path, run: &Path, truth: &Path, rea
             .map(|params| execute(&motion, params, || {}).with_context(|| shown.clone()))
             .collect::<anyhow::Result<_>>()?;
         let [fixed, ground, assisted] = [0, 1, 2].map(|i| &played[i].summary);
-        if k >= 2 {
+        if take.source == Source::Real {
             real_played += 1;
             real_up += usize::from(!ground.fell);
             real_assisted_up += usize::from(!assisted.fell);
@@ -88,7 +113,7 @@ pub(super) fn table(work: &Work, synthetic: &Path, run: &Path, truth: &Path, rea
         });
         figures["assisted"]["mean_force_share_of_weight"] = json!(pull);
         // Trial one's run, re-made by its primitives, standing.
-        if k == 1 {
+        if take.source == Source::Tracked {
             let imitation = imitate_run(run, &motion, Some(truth), &settings[1], || {})
                 .with_context(|| format!("{}: imitation by the primitives", run.display()))?;
             let block = imitation.summary.primitives.as_ref().context("an imitation names its primitives")?;
