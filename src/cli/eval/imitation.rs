@@ -83,7 +83,10 @@ pub(super) fn table(work: &Work, synthetic: &Path, run: &Path, truth: &Path, rea
         work.step(&format!("imitation: {}", take.name));
         let shown = take.bvh.display().to_string();
         let (mut motion, _) = read_take(&take.bvh, None, &RetargetOptions::default(), &mut ())?;
-        let (skip, _) = frames_to_skip(&motion, None).with_context(|| format!("{shown}: no frames"))?;
+        // A run is imitated frame for frame, as `execute --primitives` plays
+        // it: nothing of its trajectory is left out.
+        let asked = (take.source == Source::Tracked).then_some(0);
+        let (skip, _) = frames_to_skip(&motion, asked).with_context(|| format!("{shown}: no frames"))?;
         motion.poses.drain(..skip);
         let played: Vec<Execution> = settings
             .iter()
@@ -153,7 +156,7 @@ pub(super) fn table(work: &Work, synthetic: &Path, run: &Path, truth: &Path, rea
         title: "Imitation: the takes played on the simulated humanoid".into(),
         about: format!(
             "Each take played by `imitate execute` with its defaults (240 Hz, a first frame that is a bind pose left \
-             out): on a stand (fixed base), standing on the ground with balance and stepping, and on the ground with \
+             out, but not from the tracked run, imitated frame for frame): on a stand (fixed base), standing on the ground with balance and stepping, and on the ground with \
              `--assist` (the mean pull as a share of body weight); RMS joint error against the take's targets, and \
              when it fell. Trial one's run (6 particles, its first seed) is also imitated by its primitives \
              (`--primitives --truth`, standing): the upper body's root-relative error against the truth and the jerk, \
