@@ -343,7 +343,7 @@ pub fn execute(
     // Where the humanoid's pelvis was put against the trajectory's.
     let offset = humanoid.frame().position(Joint::Pelvis) - targets.pose(0).root;
     if base == Base::Free {
-        humanoid.launch(targets.root_at(0.0).velocity);
+        humanoid.launch(&targets.root_at(0.0));
     }
     if assist {
         humanoid.attach_assist();
