@@ -112,17 +112,19 @@ impl Humanoid {
     /// both feet stand, as turning about one ankle's forward axis lifts the
     /// other foot (measured: 1 of 23 real captures stayed up that way,
     /// falling sideways with the ankles at their tilt limit). Nothing
-    /// changes while no foot stands.
-    pub fn balance(&self, targets: &mut [JointTarget; JOINTS]) {
+    /// changes while no foot stands. Returns how far (m, world axes) the
+    /// turn asks the pelvis to move.
+    pub fn balance(&self, targets: &mut [JointTarget; JOINTS]) -> DVec3 {
         let state = self.balance_state();
-        let Some(support) = state.stance_centre else { return };
+        let Some(support) = state.stance_centre else { return DVec3::ZERO };
         let shift = CAPTURE_GAIN * DVec3::new(support.x - state.capture.x, 0.0, support.z - state.capture.y);
         // Turning a leg by θ about its ankle moves its hip, h above it, by
         // θ × h·Y; θ = Y × shift / h moves the pelvis by `shift`.
         let pelvis = self.rotation(Joint::Pelvis);
         let hip_height =
             (self.world.bodies[self.links[Joint::Pelvis.index()]].translation().as_dvec3().y - support.y).max(0.1);
-        let turn = DQuat::from_scaled_axis((DVec3::Y.cross(shift) / hip_height).clamp_length_max(BALANCE_MAX_RAD));
+        let tilt = (DVec3::Y.cross(shift) / hip_height).clamp_length_max(BALANCE_MAX_RAD);
+        let turn = DQuat::from_scaled_axis(tilt);
         for k in (0..2).filter(|&k| self.stands(FEET[k])) {
             // The shank turned by `turn` in the world over a foot that
             // stays, and the thigh with it under a pelvis that stays.
@@ -130,6 +132,7 @@ impl Humanoid {
             let (hip, thigh) = (HIPS[k], &mut targets[HIPS[k].index()]);
             thigh.rotation = clamp(hip, pelvis.inverse() * turn * pelvis * thigh.rotation).0;
         }
+        hip_height * tilt.cross(DVec3::Y)
     }
 
     /// Asks standing foot `k`'s sole to stay halfway between where the

@@ -366,18 +366,19 @@ pub fn execute(
         for s in 1..=steps_per_frame {
             let time_s = (k - 1) as f64 * frame_time + s as f64 * dt;
             targets.sample(time_s, &mut asked);
+            let mut balance_shift = DVec3::ZERO;
             if balance {
                 let wanted = asked;
                 match contacts.single_stance(time_s) {
                     Some((stance, ankle)) => humanoid.step_over(&mut asked, stance, ankle, &targets.root_at(time_s)),
-                    None => humanoid.balance(&mut asked),
+                    None => balance_shift = humanoid.balance(&mut asked),
                 }
                 departure_rad = motorized()
                     .map(|j| angle_between(wanted[j.index()].rotation, asked[j.index()].rotation))
                     .fold(0.0, f64::max);
             }
             if assist {
-                humanoid.assist_toward(&targets.root_at(time_s), offset);
+                humanoid.assist_toward(&targets.root_at(time_s), offset, balance_shift);
             }
             humanoid.step(&asked, gains);
             if let Some((joint, speed_m_s, spin_rad_s)) = humanoid.runaway() {

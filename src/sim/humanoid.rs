@@ -141,6 +141,9 @@ pub struct Humanoid {
     /// With assistance, the body that carries the trajectory's pelvis and
     /// the spring joint from it to the pelvis ([`super::assist`]).
     pub(super) anchor: Option<(RigidBodyHandle, ImpulseJointHandle)>,
+    /// Where the assistance's far end is moved from the trajectory's
+    /// pelvis, following the balance ([`Humanoid::assist_toward`]).
+    pub(super) assist_shift: DVec3,
 }
 
 /// Stiffness and damping of every motor per unit of the inertia it turns.
@@ -244,6 +247,7 @@ impl Humanoid {
             offsets,
             soles,
             anchor: None,
+            assist_shift: DVec3::ZERO,
         };
         humanoid.set_velocities(start);
         humanoid
