@@ -11,6 +11,7 @@ use imitate::report::eval::Table;
 use imitate::sim::execute::{ExecuteParams, Execution, Summary, ValidExecuteParams, execute, frames_to_skip};
 use imitate::sim::humanoid::Base;
 use imitate::sim::superpose::imitate_run;
+use imitate::vocab::corpus::{Labels, read_labels};
 use imitate::vocab::learn::read_take;
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
@@ -64,16 +65,11 @@ pub(super) fn table(work: &Work, synthetic: &Path, run: &Path, truth: &Path, rea
     ];
     let labels = real.join("labels.csv");
     if labels.is_file() {
-        let text = std::fs::read_to_string(&labels).with_context(|| format!("{}: cannot read", labels.display()))?;
-        for line in text.lines().skip(1).filter(|l| !l.trim().is_empty()) {
-            let mut fields = line.split(',');
-            let (Some(file), Some(activity)) = (fields.next(), fields.next()) else { continue };
-            takes.push(Take {
-                name: file.into(),
-                activity: activity.into(),
-                bvh: real.join(file),
-                source: Source::Real,
-            });
+        let Labels::PerFile(files) = read_labels(&labels)? else {
+            anyhow::bail!("{}: the real captures are labelled whole (`file,activity`)", labels.display());
+        };
+        for (file, activity) in files {
+            takes.push(Take { bvh: real.join(&file), name: file, activity, source: Source::Real });
         }
     }
     let settings = settings()?;
