@@ -11,11 +11,12 @@
 //! frame before (its median training pace at the start); the superposed
 //! pose moves by the weighted sum of those moves, then `SEEN_SHARE` of the
 //! way to the run's estimate of the frame before, so it neither drifts
-//! off what was seen nor copies the estimate's frame-to-frame noise. Nothing comes from the
-//! frame being predicted. Measured on the demo's run (`execute
-//! --primitives --truth`): the jerk 0.52× the trajectory played's
-//! standing, the upper body's root-relative error against the truth 22.8
-//! mm (the trajectory played: 28.5 mm), on a fixed base 15.6 mm (14.0 mm).
+//! off what was seen nor copies the estimate's frame-to-frame noise.
+//! Nothing comes from the frame being predicted. Measured on the demo's
+//! run (`execute --primitives --truth`): the jerk 0.52× the trajectory
+//! played's standing, the upper body's root-relative error against the
+//! truth 23.1 mm (the trajectory played: 30.0 mm), on a fixed base 15.6 mm
+//! (14.0 mm).
 //! Moving by the primitives from the estimate with no pull toward it (an
 //! earlier version, which also measured the pace between the imitation and
 //! the estimate) left the jerk 1.3× the trajectory's.
