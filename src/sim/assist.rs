@@ -135,7 +135,7 @@ mod tests {
         let mut sum = 0.0;
         for k in 0..steps {
             let mut asked = targets;
-            let shift = humanoid.balance(&mut asked);
+            let shift = humanoid.balance(&mut asked, None);
             humanoid.assist_toward(&root, DVec3::ZERO, if follow { shift } else { DVec3::ZERO });
             humanoid.step(&asked, Gains::STANDARD);
             if k >= steps - last {

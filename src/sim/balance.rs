@@ -50,6 +50,8 @@ pub struct BalanceState {
     /// The middle of the standing soles, in the world; `None` while no
     /// foot stands.
     pub stance_centre: Option<DVec3>,
+    /// The middle of each sole (left, right) while it stands.
+    pub soles: [Option<DVec3>; 2],
 }
 
 impl BalanceState {
@@ -76,7 +78,7 @@ impl Humanoid {
         }
         let (com, velocity) = (moment / mass, momentum / mass);
         let mut corners = Vec::with_capacity(8);
-        let mut middles = Vec::with_capacity(2);
+        let mut soles = [None; 2];
         for (k, foot) in FEET.into_iter().enumerate() {
             if !self.stands(foot) {
                 continue;
@@ -84,10 +86,11 @@ impl Humanoid {
             let ankle = &self.world.bodies[self.links[foot.index()]];
             let (at, turn) = (ankle.translation().as_dvec3(), to_f64(*ankle.rotation()));
             let sole = self.soles[k].map(|c| at + turn * c);
-            middles.push(sole.iter().sum::<DVec3>() / 4.0);
+            soles[k] = Some(sole.iter().sum::<DVec3>() / 4.0);
             corners.extend(sole.iter().filter(|c| c.y < CONTACT_M).map(|c| DVec2::new(c.x, c.z)));
         }
-        let stance_centre = (!middles.is_empty()).then(|| middles.iter().sum::<DVec3>() / middles.len() as f64);
+        let (sum, standing) = soles.iter().flatten().fold((DVec3::ZERO, 0), |(sum, n), &m| (sum + m, n + 1));
+        let stance_centre = (standing > 0).then(|| sum / f64::from(standing));
         let ground = stance_centre.map_or(0.0, |c| c.y);
         let height = (com.y - ground).max(0.1);
         let ahead = com + velocity / (GRAVITY_M_S2 / height).sqrt();
@@ -97,26 +100,28 @@ impl Humanoid {
             capture: DVec2::new(ahead.x, ahead.z),
             support: convex_hull(corners),
             stance_centre,
+            soles,
         }
     }
 
     /// Turns the standing legs' `targets` so that the body shifts over its
-    /// standing feet to bring its centre of mass back over them. The
-    /// correction moves the capture point toward the middle of the standing
-    /// soles, `CAPTURE_GAIN` times as far as it is off, up to
-    /// `BALANCE_MAX_RAD` of tilt. Each standing leg tilts
-    /// about its ankle by the same turn in the world and its hip turns back
-    /// by it, so the legs move as a parallelogram: the pelvis and all above
-    /// it shift without turning. Tilting the whole body about the feet
-    /// instead (the ankle strategy alone) cannot shift it sideways while
-    /// both feet stand, as turning about one ankle's forward axis lifts the
-    /// other foot (measured: 1 of 23 real captures stayed up that way,
-    /// falling sideways with the ankles at their tilt limit). Nothing
-    /// changes while no foot stands. Returns how far (m, world axes) the
-    /// turn asks the pelvis to move.
-    pub fn balance(&self, targets: &mut [JointTarget; JOINTS]) -> DVec3 {
+    /// standing feet to bring its centre of mass back over them. The correction
+    /// moves the capture point toward the middle of the standing soles (or of
+    /// foot `onto`'s, 0 left and 1 right, while it stands: where the take
+    /// already stands on that foot alone, the weight moves onto it before the
+    /// other foot lifts), `CAPTURE_GAIN` times as far as it is off, up to
+    /// `BALANCE_MAX_RAD` of tilt. Each standing leg tilts about its ankle by
+    /// the same turn in the world and its hip turns back by it, so the legs
+    /// move as a parallelogram: the pelvis and all above it shift without
+    /// turning. Tilting the whole body about the feet instead (the ankle
+    /// strategy alone) cannot shift it sideways while both feet stand, as
+    /// turning about one ankle's forward axis lifts the other foot (measured: 1
+    /// of 23 real captures stayed up that way, falling sideways with the ankles
+    /// at their tilt limit). Nothing changes while no foot stands. Returns how
+    /// far (m, world axes) the turn asks the pelvis to move.
+    pub fn balance(&self, targets: &mut [JointTarget; JOINTS], onto: Option<usize>) -> DVec3 {
         let state = self.balance_state();
-        let Some(support) = state.stance_centre else { return DVec3::ZERO };
+        let Some(support) = onto.and_then(|k| state.soles[k]).or(state.stance_centre) else { return DVec3::ZERO };
         let shift = CAPTURE_GAIN * DVec3::new(support.x - state.capture.x, 0.0, support.z - state.capture.y);
         // Turning a leg by θ about its ankle moves its hip, h above it, by
         // θ × h·Y; θ = Y × shift / h moves the pelvis by `shift`.

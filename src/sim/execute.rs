@@ -4,7 +4,7 @@
 
 use super::anthropometry::body_mass_kg;
 use super::assist::Wrench;
-use super::humanoid::{Base, GRAVITY_M_S2, Gains, Humanoid};
+use super::humanoid::{Base, FEET, GRAVITY_M_S2, Gains, Humanoid};
 use super::stepping::Contacts;
 use super::targets::{JointTarget, Targets, TargetsError, motorized};
 use crate::fsutil::{WriteError, round6, rounded, rounded_option, write_atomic, write_dir_atomic};
@@ -370,8 +370,14 @@ pub fn execute(
             if balance {
                 let wanted = asked;
                 match contacts.single_stance(time_s) {
-                    Some((stance, ankle)) => humanoid.step_over(&mut asked, stance, ankle, &targets.root_at(time_s)),
-                    None => balance_shift = humanoid.balance(&mut asked),
+                    // The swing starts when the humanoid's own foot has left
+                    // the ground, as SIMBICON's state machine switches on
+                    // contact: steered while still bearing weight, it was
+                    // torn from under the body.
+                    Some((stance, ankle)) if !humanoid.stands(FEET[1 - stance]) => {
+                        humanoid.step_over(&mut asked, stance, ankle, &targets.root_at(time_s))
+                    }
+                    stance => balance_shift = humanoid.balance(&mut asked, stance.map(|(foot, _)| foot)),
                 }
                 departure_rad = motorized()
                     .map(|j| angle_between(wanted[j.index()].rotation, asked[j.index()].rotation))

@@ -598,7 +598,7 @@ mod tests {
         assert!((start.y - body.pelvis_height()).abs() < 1e-6, "{start}");
         for _ in 0..(5.0 / DT) as usize {
             let mut targets = [JointTarget::REST; JOINTS];
-            humanoid.balance(&mut targets);
+            humanoid.balance(&mut targets, None);
             humanoid.step(&targets, Gains::STANDARD);
         }
         let frame = humanoid.frame();
@@ -624,7 +624,7 @@ mod tests {
         }
         for _ in 0..(5.0 / DT) as usize {
             let mut asked = targets;
-            humanoid.balance(&mut asked);
+            humanoid.balance(&mut asked, None);
             humanoid.step(&asked, Gains::STANDARD);
         }
         let frame = humanoid.frame();
@@ -636,5 +636,22 @@ mod tests {
         let tilt = (frame.rotation(Joint::Pelvis) * DVec3::Y).angle_between(DVec3::Y);
         assert!(tilt < 3f64.to_radians(), "the pelvis tilts {:.1}°", tilt.to_degrees());
         assert!((pelvis.y - start.y).abs() < 0.03, "the pelvis went from {start} to {pelvis}");
+    }
+
+    #[test]
+    fn asked_onto_one_foot_the_balance_carries_the_weight_over_it_with_both_feet_down() {
+        let (_, mut humanoid) = rest_humanoid(Base::Free);
+        for _ in 0..(3.0 / DT) as usize {
+            let mut targets = [JointTarget::REST; JOINTS];
+            humanoid.balance(&mut targets, Some(1));
+            humanoid.step(&targets, Gains::STANDARD);
+        }
+        let state = humanoid.balance_state();
+        let [left, right] = state.soles.map(|s| s.expect("both feet on the ground"));
+        let over = |sole: DVec3| glam::DVec2::new(sole.x - state.com.x, sole.z - state.com.z).length();
+        // The rest pose's centre of mass lies halfway between the feet,
+        // ~10 cm from each.
+        assert!(over(right) < 0.03, "{:.3} m from the right sole, {:.3} m from the left", over(right), over(left));
+        assert!(state.margin_m().is_some_and(|m| m > 0.0), "{state:?}");
     }
 }

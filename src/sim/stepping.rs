@@ -1,7 +1,8 @@
-//! Stepping: while the take stands on one foot, the humanoid's swing foot
-//! is placed where its balance needs it and its stance hip holds the trunk
-//! up (after SIMBICON, Yin et al. 2007, with the take as the reference
-//! rather than a hand-made gait, as in data-driven biped control).
+//! Stepping: while the take stands on one foot and the humanoid's other
+//! foot is off the ground, the humanoid's swing foot is placed where its
+//! balance needs it and its stance hip holds the trunk up (after SIMBICON,
+//! Yin et al. 2007, with the take as the reference rather than a hand-made
+//! gait, as in data-driven biped control).
 
 use super::humanoid::{FEET, GRAVITY_M_S2, HIPS, Humanoid};
 use super::targets::{JointTarget, RootTarget, clamp};
