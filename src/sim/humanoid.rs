@@ -296,6 +296,11 @@ impl Humanoid {
         }
     }
 
+    /// The whole body's mass, kg.
+    pub(super) fn mass_kg(&self) -> f64 {
+        self.inertials.iter().map(|i| i.mass_kg).sum()
+    }
+
     pub(super) fn rotation(&self, j: Joint) -> DQuat {
         to_f64(*self.world.bodies[self.links[j.index()]].rotation())
     }
