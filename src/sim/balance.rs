@@ -51,7 +51,7 @@ pub struct BalanceState {
     /// foot stands.
     pub stance_centre: Option<DVec3>,
     /// The middle of each sole (left, right) while it stands.
-    pub soles: [Option<DVec3>; 2],
+    pub sole_middles: [Option<DVec3>; 2],
 }
 
 impl BalanceState {
@@ -78,7 +78,7 @@ impl Humanoid {
         }
         let (com, velocity) = (moment / mass, momentum / mass);
         let mut corners = Vec::with_capacity(8);
-        let mut soles = [None; 2];
+        let mut sole_middles = [None; 2];
         for (k, foot) in FEET.into_iter().enumerate() {
             if !self.stands(foot) {
                 continue;
@@ -86,10 +86,10 @@ impl Humanoid {
             let ankle = &self.world.bodies[self.links[foot.index()]];
             let (at, turn) = (ankle.translation().as_dvec3(), to_f64(*ankle.rotation()));
             let sole = self.soles[k].map(|c| at + turn * c);
-            soles[k] = Some(sole.iter().sum::<DVec3>() / 4.0);
+            sole_middles[k] = Some(sole.iter().sum::<DVec3>() / 4.0);
             corners.extend(sole.iter().filter(|c| c.y < CONTACT_M).map(|c| DVec2::new(c.x, c.z)));
         }
-        let (sum, standing) = soles.iter().flatten().fold((DVec3::ZERO, 0), |(sum, n), &m| (sum + m, n + 1));
+        let (sum, standing) = sole_middles.iter().flatten().fold((DVec3::ZERO, 0), |(sum, n), &m| (sum + m, n + 1));
         let stance_centre = (standing > 0).then(|| sum / f64::from(standing));
         let ground = stance_centre.map_or(0.0, |c| c.y);
         let height = (com.y - ground).max(0.1);
@@ -100,7 +100,7 @@ impl Humanoid {
             capture: DVec2::new(ahead.x, ahead.z),
             support: convex_hull(corners),
             stance_centre,
-            soles,
+            sole_middles,
         }
     }
 
@@ -121,7 +121,9 @@ impl Humanoid {
     /// far (m, world axes) the turn asks the pelvis to move.
     pub fn balance(&self, targets: &mut [JointTarget; JOINTS], onto: Option<usize>) -> DVec3 {
         let state = self.balance_state();
-        let Some(support) = onto.and_then(|k| state.soles[k]).or(state.stance_centre) else { return DVec3::ZERO };
+        let Some(support) = onto.and_then(|k| state.sole_middles[k]).or(state.stance_centre) else {
+            return DVec3::ZERO;
+        };
         let shift = CAPTURE_GAIN * DVec3::new(support.x - state.capture.x, 0.0, support.z - state.capture.y);
         // Turning a leg by θ about its ankle moves its hip, h above it, by
         // θ × h·Y; θ = Y × shift / h moves the pelvis by `shift`.

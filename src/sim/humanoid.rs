@@ -652,7 +652,7 @@ mod tests {
             humanoid.step(&targets, Gains::STANDARD);
         }
         let state = humanoid.balance_state();
-        let [left, right] = state.soles.map(|s| s.expect("both feet on the ground"));
+        let [left, right] = state.sole_middles.map(|s| s.expect("both feet on the ground"));
         let over = |sole: DVec3| glam::DVec2::new(sole.x - state.com.x, sole.z - state.com.z).length();
         // The rest pose's centre of mass lies halfway between the feet,
         // ~10 cm from each.
