@@ -9,7 +9,7 @@ use crate::mocap::body::{JOINTS, Joint};
 use glam::{DQuat, DVec2, DVec3};
 
 /// The most the balance may tilt a standing leg about its ankle.
-const BALANCE_MAX_RAD: f64 = 0.25;
+pub(super) const BALANCE_MAX_RAD: f64 = 0.25;
 /// How far the balance moves the pelvis for each metre the capture point
 /// lies from the middle of the standing soles. The legs' turn moves the
 /// centre of mass less than the pelvis (the legs turn with it, partly),
@@ -159,7 +159,7 @@ impl Humanoid {
 /// The convex hull of `points`, each edge turning left to the next (a
 /// positive perp_dot, the orientation [`signed_distance`] expects), without
 /// repeated or collinear points (Andrew's monotone chain).
-fn convex_hull(mut points: Vec<DVec2>) -> Vec<DVec2> {
+pub(super) fn convex_hull(mut points: Vec<DVec2>) -> Vec<DVec2> {
     points.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
     points.dedup();
     if points.len() < 3 {
@@ -179,6 +179,32 @@ fn convex_hull(mut points: Vec<DVec2>) -> Vec<DVec2> {
         hull.pop();
     }
     hull
+}
+
+/// The point nearest `p` on the straight way from it to the middle of the
+/// convex polygon `hull` (the mean of its corners) that lies at least
+/// `inset` inside it: `p` itself if it does, the middle if no point does.
+pub(super) fn brought_inside(hull: &[DVec2], p: DVec2, inset: f64) -> DVec2 {
+    let inside = |q: DVec2| signed_distance(hull, q).is_some_and(|d| d >= inset);
+    if hull.is_empty() || inside(p) {
+        return p;
+    }
+    let middle = hull.iter().sum::<DVec2>() / hull.len() as f64;
+    if !inside(middle) {
+        return middle;
+    }
+    // The distance inside grows along the way (the polygon is convex):
+    // halve the share of the way that is known to reach the inset.
+    let (mut short, mut far) = (0.0, 1.0);
+    for _ in 0..40 {
+        let half = 0.5 * (short + far);
+        if inside(p.lerp(middle, half)) {
+            far = half;
+        } else {
+            short = half;
+        }
+    }
+    p.lerp(middle, far)
 }
 
 /// The distance from `p` to the nearest edge of the convex polygon `hull`
@@ -232,5 +258,19 @@ mod tests {
         assert!(close(signed_distance(&edge, DVec2::new(0.0, 0.1)), 0.0));
         assert!(close(signed_distance(&edge, DVec2::new(0.1, 0.1)), -0.1));
         assert_eq!(signed_distance(&[], DVec2::ZERO), None);
+    }
+
+    #[test]
+    fn a_point_is_brought_the_inset_inside_on_its_way_to_the_middle() {
+        let square =
+            convex_hull([(0.0, 0.0), (0.4, 0.0), (0.4, 0.4), (0.0, 0.4)].map(|(x, z)| DVec2::new(x, z)).to_vec());
+        let close = |a: DVec2, b: DVec2| a.distance(b) < 1e-9;
+        // Behind the square's middle: straight in to 0.1 inside.
+        assert!(close(brought_inside(&square, DVec2::new(0.2, -0.3), 0.1), DVec2::new(0.2, 0.1)));
+        // Already that far inside: left alone.
+        assert!(close(brought_inside(&square, DVec2::new(0.15, 0.3), 0.1), DVec2::new(0.15, 0.3)));
+        // An inset no point reaches: the middle.
+        assert!(close(brought_inside(&square, DVec2::new(0.9, 0.9), 0.3), DVec2::new(0.2, 0.2)));
+        assert!(close(brought_inside(&[], DVec2::ONE, 0.1), DVec2::ONE));
     }
 }

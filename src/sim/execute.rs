@@ -6,6 +6,7 @@ use super::anthropometry::body_mass_kg;
 use super::assist::Wrench;
 use super::humanoid::{Base, FEET, GRAVITY_M_S2, Gains, Humanoid};
 use super::stepping::Contacts;
+use super::support::over_support;
 use super::targets::{JointTarget, Targets, TargetsError, motorized};
 use crate::fsutil::{WriteError, round6, rounded, rounded_option, write_atomic, write_dir_atomic};
 use crate::mocap::body::{JOINTS, Joint, Kind};
@@ -326,12 +327,15 @@ pub fn execute(
     };
     let motion = &levelled;
     let targets = Targets::new(motion)?;
+    // The motors follow the take set over the humanoid's feet; the
+    // humanoid is scored against the take itself.
+    let played = if balance { Targets::new(&over_support(motion, &contacts))? } else { targets.clone() };
     let frame_time = targets.frame_time_s();
     let steps_per_frame = ((rate_hz * frame_time) - 1e-9).ceil().max(1.0) as usize;
     let dt = frame_time / steps_per_frame as f64;
     let mut asked = [JointTarget::REST; JOINTS];
-    targets.sample(0.0, &mut asked);
-    let mut humanoid = Humanoid::new(&motion.body, base, targets.pose(0), &asked, dt);
+    played.sample(0.0, &mut asked);
+    let mut humanoid = Humanoid::new(&motion.body, base, played.pose(0), &asked, dt);
     let (mut torque, mut at_limit) = ([DVec3::ZERO; JOINTS], [false; JOINTS]);
     let mut peak = [0.0f64; JOINTS];
     let mut limited_steps = [0usize; JOINTS];
@@ -341,9 +345,9 @@ pub fn execute(
 
     let mut frames = Vec::with_capacity(targets.frames());
     // Where the humanoid's pelvis was put against the trajectory's.
-    let offset = humanoid.frame().position(Joint::Pelvis) - targets.pose(0).root;
+    let offset = humanoid.frame().position(Joint::Pelvis) - played.pose(0).root;
     if base == Base::Free {
-        humanoid.launch(&targets.root_at(0.0));
+        humanoid.launch(&played.root_at(0.0));
     }
     if assist {
         humanoid.attach_assist();
@@ -365,17 +369,18 @@ pub fn execute(
         let asked_lean = lean(&motion.body.forward(targets.pose(k)));
         for s in 1..=steps_per_frame {
             let time_s = (k - 1) as f64 * frame_time + s as f64 * dt;
-            targets.sample(time_s, &mut asked);
+            played.sample(time_s, &mut asked);
             let mut balance_shift = DVec3::ZERO;
             if balance {
-                let wanted = asked;
+                let mut wanted = asked;
+                targets.sample(time_s, &mut wanted);
                 match contacts.single_stance(time_s) {
                     // The swing starts when the humanoid's own foot has left
                     // the ground, as SIMBICON's state machine switches on
                     // contact: steered while still bearing weight, it was
                     // torn from under the body.
                     Some((stance, ankle)) if !humanoid.stands(FEET[1 - stance]) => {
-                        humanoid.step_over(&mut asked, stance, ankle, &targets.root_at(time_s))
+                        humanoid.step_over(&mut asked, stance, ankle, &played.root_at(time_s))
                     }
                     stance => balance_shift = humanoid.balance(&mut asked, stance.map(|(foot, _)| foot)),
                 }
@@ -384,7 +389,7 @@ pub fn execute(
                     .fold(0.0, f64::max);
             }
             if assist {
-                humanoid.assist_toward(&targets.root_at(time_s), offset, balance_shift);
+                humanoid.assist_toward(&played.root_at(time_s), offset, balance_shift);
             }
             humanoid.step(&asked, gains);
             if let Some((joint, speed_m_s, spin_rad_s)) = humanoid.runaway() {

@@ -105,6 +105,21 @@ fn shapes(body: &Body) -> [Shape; JOINTS] {
     })
 }
 
+/// The corners of each foot's sole (left, right) in its ankle's frame.
+fn sole_corners(shapes: &[Shape; JOINTS]) -> [[DVec3; 4]; 2] {
+    FEET.map(|foot| match shapes[foot.index()] {
+        Shape::Box { center, half } => [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            .map(|(x, z)| center + DVec3::new(x * half.x, -half.y, z * half.z)),
+        Shape::Capsule { .. } => unreachable!("the feet are boxes"),
+    })
+}
+
+/// The corners of `body`'s soles (left, right), each in its ankle's frame,
+/// as its humanoid stands on them.
+pub(super) fn soles(body: &Body) -> [[DVec3; 4]; 2] {
+    sole_corners(&shapes(body))
+}
+
 /// One joint's motors: one about a hinge's axis, three about a ball
 /// joint's (rapier's AngX, AngY, AngZ).
 #[derive(Clone, Debug)]
@@ -229,11 +244,7 @@ impl Humanoid {
             .collect();
         let carried = Joint::ALL.map(|j| Joint::ALL.into_iter().filter(|&c| carries(j, c)).collect());
         let offsets = Joint::ALL.map(|j| body.offset(j));
-        let soles = FEET.map(|foot| match shapes[foot.index()] {
-            Shape::Box { center, half } => [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-                .map(|(x, z)| center + DVec3::new(x * half.x, -half.y, z * half.z)),
-            Shape::Capsule { .. } => unreachable!("the feet are boxes"),
-        });
+        let soles = sole_corners(&shapes);
         let mut humanoid = Humanoid {
             world,
             links,

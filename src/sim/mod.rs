@@ -9,4 +9,5 @@ pub mod execute;
 pub mod humanoid;
 pub mod stepping;
 pub mod superpose;
+pub mod support;
 pub mod targets;

@@ -74,6 +74,11 @@ impl Contacts {
         Contacts { frame_time_s: dt, standing, ankles }
     }
 
+    /// Which of the take's feet (left, right) stand on frame `k`.
+    pub fn standing(&self, k: usize) -> [bool; 2] {
+        self.standing[k]
+    }
+
     /// The one foot the take stands on at `time_s` (0 left, 1 right) and
     /// where its ankle is; `None` while it stands on both or neither.
     pub fn single_stance(&self, time_s: f64) -> Option<(usize, DVec3)> {
