@@ -21,12 +21,16 @@ use crate::mocap::pose::{Motion, Pose};
 use glam::{DQuat, DVec2, DVec3};
 
 /// How far inside the edge of its feet the take's centre of mass is
-/// brought. Over bandai's 88 standing gestures and real/'s 13 (stayed up;
-/// RMS joint error against the take where up, worst): none 82 and 9 (4.0°,
-/// 2.8°), 3 cm the same, 6 cm 82 and 11, 7 cm 81 and 11, 8 cm 82 and 10,
-/// 9 cm 82 and 12 (8.7°, 6.7°), 10 cm 82 and 12, 12 cm 81 and 12, the
-/// middle of the soles 82 and 12 (9.3°, 7.3°).
-const INSET_M: f64 = 0.09;
+/// brought: an upright stance, its centre of mass over the ankles (the
+/// heels' edge 6.4 cm behind), is left alone. Over bandai's 88 standing
+/// gestures and real/'s 13 (stayed up; RMS joint error against the take
+/// where up, worst): none 82 and 9 (4.0°, 2.8°), 3 cm the same, 6 cm 82
+/// and 11 (4.0°, 6.9°), 7 cm 81 and 11, 8 cm 82 and 10, 9 cm 82 and 12
+/// (8.7°, 6.7°), 10 cm 82 and 12, 12 cm 81 and 12, the middle of the soles
+/// 82 and 12 (9.3°, 7.3°). From 9 cm the demo's synthetic demonstrator,
+/// standing upright, is tilted too: its trajectory played on the ground
+/// strays 50.4 mm from the truth against 30.0 mm up to 6 cm.
+const INSET_M: f64 = 0.06;
 /// The tilt is averaged over this long either side of each frame, so the
 /// legs ease into and out of it as the take puts a foot down or lifts it.
 const SMOOTHING_S: f64 = 0.25;
@@ -151,10 +155,11 @@ mod tests {
         let contacts = Contacts::of(&take);
         let over = over_support(&take, &contacts);
         let ankle_z = take.body.forward(&take.poses[10]).position(FEET[0]).z;
-        // 10 cm behind the ankles, 4 cm beyond the heels' edge; after, over
-        // the soles' back half.
+        // 10 cm behind the ankles, 3 cm beyond the heels' edge; after,
+        // within 2 cm of the inset (0.4 cm behind the ankles): the legs
+        // turn with the pelvis, so the centre of mass moves less than it.
         assert!(com(&take, 10).z < ankle_z - 0.09, "{:?}", com(&take, 10));
-        assert!(com(&over, 10).z > ankle_z - 0.01, "{:?} → {:?}", com(&take, 10), com(&over, 10));
+        assert!(com(&over, 10).z > ankle_z - 0.024, "{:?} → {:?}", com(&take, 10), com(&over, 10));
         let (before, after) = (take.body.forward(&take.poses[10]), over.body.forward(&over.poses[10]));
         for foot in FEET {
             assert!(before.position(foot).distance(after.position(foot)) < 1e-6, "{foot:?}");
