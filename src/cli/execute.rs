@@ -47,9 +47,10 @@ pub struct Args {
     /// stand, no ground): upper-body imitation.
     #[arg(long)]
     pub fixed_base: bool,
-    /// On a free base, leave the ankles to the trajectory alone: no
-    /// balance (by default their targets are offset to keep the centre of
-    /// mass over the feet).
+    /// On a free base, leave the legs to the trajectory alone: no
+    /// balance (by default the take is set over the feet before it is
+    /// played and the legs' targets are offset to keep the centre of mass
+    /// over them, stepping when the take stands on one foot).
     #[arg(long)]
     pub no_balance: bool,
     /// On a free base, pull the pelvis toward the trajectory's with a

@@ -23,8 +23,10 @@ use std::path::Path;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ExecuteParams {
     pub base: Base,
-    /// On a free base, turn the ankles' targets to keep the centre of mass
-    /// over the feet ([`Humanoid::balance`]).
+    /// On a free base, set the take over the feet before it is played
+    /// ([`super::support`]) and turn the legs' targets to keep the centre
+    /// of mass over them ([`Humanoid::balance`]), stepping where the take
+    /// stands on one foot.
     pub balance: bool,
     /// On a free base, pull the pelvis toward the trajectory's with a
     /// residual force and torque ([`super::assist`]), reported.
