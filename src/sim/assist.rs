@@ -100,7 +100,7 @@ impl Humanoid {
     /// not drag the pelvis back against the balance's corrections; the
     /// pull stiffens as the pelvis tilts away from `target`'s
     /// (`STIFFEN_FROM_RAD`, `STIFFEN_MAX`), and acts only as far as the
-    /// humanoid needs it ([`need`]).
+    /// humanoid needs it (`NEED_MARGIN_M`, `NEED_TILT_RAD`).
     pub fn assist_toward(&mut self, target: &RootTarget, offset: DVec3, balance_shift: DVec3) {
         let dt = f64::from(self.world.integration_parameters.dt);
         self.assist_shift += (balance_shift - self.assist_shift) * (dt / FOLLOW_BALANCE_S).min(1.0);
