@@ -2,8 +2,8 @@
 //! retargeted capture keeps the person's joint angles, not their balance:
 //! on the canonical body's masses and feet, a take standing still may hold
 //! its centre of mass over its heels or the outer edge of a foot (bandai's
-//! musical bow and guide: 6 cm behind the ankles, the heel's edge 6.4 cm
-//! behind), and the humanoid starts falling on the first frame, faster than
+//! musical guide: 6 cm behind the ankles, the heel's edge 6.4 cm behind),
+//! and the humanoid starts falling on the first frame, faster than
 //! the balance's feedback can bring it back (its legs at their tilt limit
 //! within 0.1 s, the feet rolled onto their heels). Where the take stands
 //! on both feet, its standing legs are tilted ahead of time, as the balance
