@@ -331,7 +331,8 @@ pub fn execute(
     let targets = Targets::new(motion)?;
     // The motors follow the take set over the humanoid's feet; the
     // humanoid is scored against the take itself.
-    let played = if balance { Targets::new(&over_support(motion, &contacts))? } else { targets.clone() };
+    let set_over_feet = if balance { Some(Targets::new(&over_support(motion, &contacts))?) } else { None };
+    let played = set_over_feet.as_ref().unwrap_or(&targets);
     let frame_time = targets.frame_time_s();
     let steps_per_frame = ((rate_hz * frame_time) - 1e-9).ceil().max(1.0) as usize;
     let dt = frame_time / steps_per_frame as f64;

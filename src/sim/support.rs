@@ -12,12 +12,12 @@
 //! The played pose departs from the take by this tilt; `execute` scores
 //! against the take and counts the tilt in the departure.
 
-use super::anthropometry::inertials;
+use super::anthropometry::{Inertial, inertials};
 use super::balance::{BALANCE_MAX_RAD, brought_inside, convex_hull};
 use super::humanoid::{FEET, HIPS, soles};
 use super::stepping::Contacts;
-use crate::mocap::body::{Body, Joint};
-use crate::mocap::pose::{Motion, Pose};
+use crate::mocap::body::{Body, JOINTS, Joint};
+use crate::mocap::pose::{BodyFrame, Motion, Pose};
 use glam::{DQuat, DVec2, DVec3};
 
 /// How far inside the edge of its feet the take's centre of mass is
@@ -53,7 +53,6 @@ pub fn over_support(motion: &Motion, contacts: &Contacts) -> Motion {
 fn shifts(motion: &Motion, contacts: &Contacts) -> Vec<DVec3> {
     let body = &motion.body;
     let links = inertials(body);
-    let mass: f64 = links.iter().map(|l| l.mass_kg).sum();
     let corners = soles(body);
     let on_ground = |p: DVec3| DVec2::new(p.x, p.z);
     motion
@@ -65,11 +64,7 @@ fn shifts(motion: &Motion, contacts: &Contacts) -> Vec<DVec3> {
                 return DVec3::ZERO;
             }
             let frame = body.forward(pose);
-            let weighted = Joint::ALL.iter().map(|&j| {
-                let link = &links[j.index()];
-                link.mass_kg * (frame.position(j) + frame.rotation(j) * link.com)
-            });
-            let com = on_ground(weighted.sum::<DVec3>() / mass);
+            let com = on_ground(centre_of_mass(&links, &frame));
             let soles = FEET.into_iter().zip(&corners).flat_map(|(foot, sole)| {
                 let (at, turn) = (frame.position(foot), frame.rotation(foot));
                 sole.map(|c| on_ground(at + turn * c))
@@ -78,6 +73,16 @@ fn shifts(motion: &Motion, contacts: &Contacts) -> Vec<DVec3> {
             DVec3::new(to.x, 0.0, to.y)
         })
         .collect()
+}
+
+/// The centre of mass of the body in `frame`, its links weighing as
+/// `links` says.
+fn centre_of_mass(links: &[Inertial; JOINTS], frame: &BodyFrame) -> DVec3 {
+    let weighted = Joint::ALL.iter().map(|&j| {
+        let link = &links[j.index()];
+        link.mass_kg * (frame.position(j) + frame.rotation(j) * link.com)
+    });
+    weighted.sum::<DVec3>() / links.iter().map(|l| l.mass_kg).sum::<f64>()
 }
 
 /// Each entry averaged with its neighbours up to `half` away.
@@ -127,7 +132,7 @@ mod tests {
     /// bent back by `lean` (radians) at the spine and at the chest.
     fn standing(lean: f64, frames: usize) -> Motion {
         let body = Body::standard();
-        let mut local = [DQuat::IDENTITY; crate::mocap::body::JOINTS];
+        let mut local = [DQuat::IDENTITY; JOINTS];
         for j in [Joint::Spine, Joint::Chest] {
             local[j.index()] = DQuat::from_rotation_x(-lean);
         }
@@ -141,12 +146,7 @@ mod tests {
     }
 
     fn com(motion: &Motion, k: usize) -> DVec3 {
-        let links = inertials(&motion.body);
-        let frame = motion.body.forward(&motion.poses[k]);
-        let weighted = Joint::ALL
-            .iter()
-            .map(|&j| links[j.index()].mass_kg * (frame.position(j) + frame.rotation(j) * links[j.index()].com));
-        weighted.sum::<DVec3>() / links.iter().map(|l| l.mass_kg).sum::<f64>()
+        centre_of_mass(&inertials(&motion.body), &motion.body.forward(&motion.poses[k]))
     }
 
     #[test]
