@@ -22,6 +22,10 @@ pub const STANDARD_MASS_KG: f64 = 70.0;
 const TRUNK_HALF_WIDTH: f64 = 0.09;
 const TRUNK_HALF_DEPTH: f64 = 0.06;
 
+/// The foot's breadth as a share of height (Winter's segment lengths, Fig.
+/// 4.1: 0.055 H, 9.6 cm at 1.75 m).
+const FOOT_BREADTH: f64 = 0.055;
+
 /// The head-and-neck segment is one row of the table; it is split between
 /// the neck and head links in proportion to the volumes of their capsules.
 const HEAD_AND_NECK_SHARE: f64 = 0.081;
@@ -94,6 +98,11 @@ fn limb(j: Joint) -> Option<Limb> {
 /// The body's mass, kg.
 pub fn body_mass_kg(body: &Body) -> f64 {
     STANDARD_MASS_KG * (body.proportions.height_m / Body::STANDARD_HEIGHT_M).powi(2)
+}
+
+/// The foot's breadth, meters: the width of the sole it stands on.
+pub fn foot_breadth_m(body: &Body) -> f64 {
+    FOOT_BREADTH * body.proportions.height_m
 }
 
 /// The bone a link runs along, from its joint, in its own frame.
