@@ -203,7 +203,7 @@ impl Humanoid {
         // by default; a standing foot, pressed into the ground and pushed
         // sideways by that pass, then creeps (measured: both feet of a
         // quiet, symmetric stance slid 2 cm sideways in 3 s, and the
-        // body with them; with friction in that pass, 3 mm).
+        // body with them; with friction in that pass, about 3 mm).
         world.integration_parameters.friction_in_bias_pass = true;
         let shapes = shapes(body);
         let inertials = inertials(body);
