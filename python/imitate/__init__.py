@@ -156,7 +156,7 @@ def execute(
     fixed_base: bool = False,
     balance: bool = True,
     gains: Tuple[float, float] = (10000.0, 200.0),
-    rate: float = 240.0,
+    rate: float = 480.0,
     skip: Optional[int] = None,
     assist: bool = False,
     primitives: Optional[PathLike] = None,

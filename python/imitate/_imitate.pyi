@@ -201,7 +201,7 @@ def execute_table(
     fixed_base: bool = False,
     balance: bool = True,
     gains: Tuple[float, float] = (10000.0, 200.0),
-    rate: float = 240.0,
+    rate: float = 480.0,
     skip: Optional[int] = None,
     assist: bool = False,
     primitives: Optional[_Path] = None,

@@ -673,7 +673,7 @@ pub fn score_run(py: Python<'_>, run: PathBuf, truth: PathBuf, settle: f64) -> P
 /// and returns ``execution.csv``'s text, writing the execution's folder
 /// to `out` when given.
 #[pyfunction]
-#[pyo3(signature = (motion, out=None, force=false, fixed_base=false, balance=true, gains=(10000.0, 200.0), rate=240.0, skip=None, assist=false, primitives=None, truth=None))]
+#[pyo3(signature = (motion, out=None, force=false, fixed_base=false, balance=true, gains=(10000.0, 200.0), rate=ExecuteParams::DEFAULT_RATE_HZ, skip=None, assist=false, primitives=None, truth=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn execute_table(
     py: Python<'_>,

@@ -65,7 +65,7 @@ pub struct Args {
     pub gains: String,
     /// Physics steps a second; rounded up to a whole number of steps per
     /// frame of the trajectory.
-    #[arg(long, value_name = "HZ", default_value_t = 240.0, allow_hyphen_values = true)]
+    #[arg(long, value_name = "HZ", default_value_t = ExecuteParams::DEFAULT_RATE_HZ, allow_hyphen_values = true)]
     pub rate: f64,
     /// Leave out the trajectory's first N frames. By default the first
     /// frame is left out when it is a bind pose (a T-pose many motion

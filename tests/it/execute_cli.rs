@@ -12,6 +12,7 @@ use imitate::mocap::body::{Body, Joint};
 use imitate::mocap::bvh::{read_bvh, write_bvh};
 use imitate::mocap::pose::{Motion, Pose};
 use imitate::mocap::retarget::{RetargetOptions, Retargeter};
+use imitate::sim::execute::ExecuteParams;
 use serde_json::Value;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -106,7 +107,7 @@ fn the_four_paper_activities_are_followed_within_three_degrees_on_a_fixed_base()
             }
             assert_eq!(s["base"], "fixed");
             assert_eq!(s["fell"], false);
-            assert_eq!(s["rate_hz"], 240.0);
+            assert_eq!(s["rate_hz"], ExecuteParams::DEFAULT_RATE_HZ);
             // The joints hold together: rapier's joints are kept by its solver.
             assert!(number(&s, "max_joint_gap_mm") < 1.0, "{s}");
         }

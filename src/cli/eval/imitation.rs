@@ -151,12 +151,13 @@ pub(super) fn table(work: &Work, synthetic: &Path, run: &Path, truth: &Path, rea
         key: "imitation".into(),
         title: "Imitation: the takes played on the simulated humanoid".into(),
         about: format!(
-            "Each take played by `imitate execute` with its defaults (240 Hz, a first frame that is a bind pose left \
-             out, but not from the tracked run, imitated frame for frame): on a stand (fixed base), standing on the ground with balance and stepping, and on the ground with \
+            "Each take played by `imitate execute` with its defaults ({rate} Hz, a first frame that is a bind pose \
+             left out, but not from the tracked run, imitated frame for frame): on a stand (fixed base), standing on the ground with balance and stepping, and on the ground with \
              `--assist` (the mean pull as a share of body weight); RMS joint error against the take's targets, and \
              when it fell. Trial one's run (6 particles, its first seed) is also imitated by its primitives \
              (`--primitives --truth`, standing): the upper body's root-relative error against the truth and the jerk, \
-             against its trajectory played as it is.{real_note}"
+             against its trajectory played as it is.{real_note}",
+            rate = ExecuteParams::DEFAULT_RATE_HZ
         ),
         columns: [
             "take",
