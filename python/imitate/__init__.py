@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any, Dict, Optional, Tuple, Union
 
 from . import _imitate
 from ._imitate import (
+    EXECUTE_RATE_HZ,
     JOINT_NAMES,
     KEYPOINT_SITES,
     Camera,
@@ -46,6 +47,7 @@ if TYPE_CHECKING:
     PathLike = Union[str, "os.PathLike[str]"]
 
 __all__ = [
+    "EXECUTE_RATE_HZ",
     "JOINT_NAMES",
     "KEYPOINT_SITES",
     "BvhError",
@@ -156,7 +158,7 @@ def execute(
     fixed_base: bool = False,
     balance: bool = True,
     gains: Tuple[float, float] = (10000.0, 200.0),
-    rate: float = 480.0,
+    rate: float = EXECUTE_RATE_HZ,
     skip: Optional[int] = None,
     assist: bool = False,
     primitives: Optional[PathLike] = None,

@@ -13,6 +13,8 @@ JOINT_NAMES: List[str]
 """The 17 canonical joints, in the order of every joints array."""
 KEYPOINT_SITES: List[str]
 """The 15 keypoint sites, in the order of a keypoints array's rows."""
+EXECUTE_RATE_HZ: float
+"""The physics rate ``execute`` runs at by default, steps a second."""
 __version__: str
 
 def read_bvh(path: _Path, up: Optional[str] = None, mapping: Optional[_Path] = None) -> Motion:
@@ -201,7 +203,7 @@ def execute_table(
     fixed_base: bool = False,
     balance: bool = True,
     gains: Tuple[float, float] = (10000.0, 200.0),
-    rate: float = 480.0,
+    rate: float = ...,
     skip: Optional[int] = None,
     assist: bool = False,
     primitives: Optional[_Path] = None,

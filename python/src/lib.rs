@@ -29,6 +29,7 @@ fn _imitate(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("JOINT_NAMES", joints)?;
     let sites: Vec<&str> = imitate::vision::keypoints::Site::ALL.iter().map(|s| s.name()).collect();
     m.add("KEYPOINT_SITES", sites)?;
+    m.add("EXECUTE_RATE_HZ", imitate::sim::execute::ExecuteParams::DEFAULT_RATE_HZ)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

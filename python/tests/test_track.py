@@ -131,6 +131,8 @@ def test_execute_returns_the_cli_execution_table_and_writes_its_folder(tmp_path,
     pd.testing.assert_frame_equal(table, read_csv(tmp_path / "run" / "execution.csv"))
     for name in ["executed.bvh", "execution.csv", "summary.json"]:
         assert (tmp_path / "mine" / name).read_bytes() == (tmp_path / "run" / name).read_bytes(), name
+    # The command's default rate is the package's.
+    assert json.loads((tmp_path / "run" / "summary.json").read_text())["rate_hz"] == imitate.EXECUTE_RATE_HZ
     with pytest.raises(imitate.Error, match="exists and is not empty"):
         imitate.execute("mocap/punch.bvh", out=tmp_path / "mine", fixed_base=True)
 
