@@ -6,7 +6,8 @@
 # ../shared/mocap/real (grouped by its labels.csv: standing, walking, moving
 # in place), each as a new user runs it (no flags but the ones
 # given here). Prints per group how many stay up, the RMS joint error of
-# those that do, and lists the falls; the table is also written to
+# those that do, how closely the feet followed the take's own contacts
+# (summary.json's contact_agreement), and lists the falls; the table is also written to
 # WORK_DIR/execute-trials.md.
 #
 #   bash scripts/execute-trials.sh [WORK_DIR] [-- EXECUTE_FLAGS...]   # under a minute on 2 cores
@@ -68,14 +69,14 @@ from pathlib import Path
 flags = sys.argv[1]
 assisted = "--assist" in flags.split()
 lines = [f"`imitate execute {flags}`".replace(" `", "`"), "",
-         "| takes | played | stay up | RMS joint error where up (median, max) | "
+         "| takes | played | stay up | RMS joint error where up (median, max) | feet as the take's (median) | "
          + ("mean assisting force, share of body weight (median, max) | " if assisted else "")
          + "falls (at s) |",
-         "| --- | --- | --- | --- | " + ("--- | " if assisted else "") + "--- |"]
+         "| --- | --- | --- | --- | --- | " + ("--- | " if assisted else "") + "--- |"]
 for group in sorted(Path("runs").iterdir()):
     if not group.is_dir():
         continue
-    played, up, errors, falls, refused, shares = 0, 0, [], [], [], []
+    played, up, errors, falls, refused, shares, agreement = 0, 0, [], [], [], [], []
     # Every take played leaves its stderr; a refused one no folder.
     for err in sorted(group.glob("*.err")):
         run = err.with_suffix("")
@@ -85,6 +86,8 @@ for group in sorted(Path("runs").iterdir()):
             continue
         s = json.loads(summary.read_text())
         played += 1
+        if s.get("contact_agreement") is not None:
+            agreement.append(s["contact_agreement"])
         if s.get("assist"):
             shares.append(s["assist"]["mean_force_share_of_weight"])
         if s["fell"]:
@@ -97,8 +100,10 @@ for group in sorted(Path("runs").iterdir()):
     share = 100 * up / played if played else 0
     refused_note = f"; refused: {', '.join(refused)}" if refused else ""
     shares.sort()
+    agreement.sort()
+    feet = f"{100 * agreement[len(agreement) // 2]:.0f}%" if agreement else "—"
     pull = f"{100 * shares[len(shares) // 2]:.0f}%, {100 * shares[-1]:.0f}% | " if shares else ("— | " if assisted else "")
-    lines.append(f"| {group.name} | {played} | {up} ({share:.0f}%) | {where_up} | {pull}"
+    lines.append(f"| {group.name} | {played} | {up} ({share:.0f}%) | {where_up} | {feet} | {pull}"
                  f"{'; '.join(falls) or '—'}{refused_note} |")
 text = "\n".join(lines)
 Path("execute-trials.md").write_text(text + "\n")

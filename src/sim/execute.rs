@@ -148,6 +148,12 @@ pub struct ExecutedFrame {
     /// The assistance on the pelvis in the step that ended here (zero
     /// without `assist`).
     pub assist: Wrench,
+    /// Whether each of the humanoid's feet (left, right) touched the
+    /// ground; `None` on a fixed base and on the first frame.
+    pub feet_down: Option<[bool; 2]>,
+    /// Whether the take stood on each foot (left, right) on this frame
+    /// ([`Contacts`]: from its ankles' heights and speeds).
+    pub take_feet_down: [bool; 2],
 }
 
 /// A trajectory played on the humanoid.
@@ -212,6 +218,14 @@ pub struct Summary {
     pub departure_rms_deg: f64,
     #[serde(serialize_with = "rounded")]
     pub departure_max_deg: f64,
+    /// How closely the feet followed the take's own contacts: the share of
+    /// the feet on the frames after the first, before a fall, that touched
+    /// the ground exactly when the take stood on them
+    /// ([`ExecutedFrame::feet_down`] against
+    /// [`ExecutedFrame::take_feet_down`]); `None` on a fixed base or
+    /// without such a frame.
+    #[serde(serialize_with = "rounded_option")]
+    pub contact_agreement: Option<f64>,
     /// How smoothly the humanoid moved: the RMS over every joint and frame
     /// (from the second) of its position's third derivative (m/s³, by
     /// finite differences at the frame rate).
@@ -376,8 +390,22 @@ pub fn execute(
         let mut error_rad = Joint::ALL.map(|j| angle_between(asked.local_rotation(j), achieved.local_rotation(j)));
         error_rad[Joint::Pelvis.index()] = angle_between(asked.tilt(), achieved.tilt());
         let margin_m = (base == Base::Free).then(|| humanoid.balance_state().margin_m()).flatten();
+        // The first frame is where the humanoid was put: the physics has
+        // not yet found its contacts.
+        let feet_down = (base == Base::Free && k > 0).then(|| FEET.map(|foot| humanoid.stands(foot)));
+        let take_feet_down = contacts.standing(k);
         let time_s = k as f64 * frame_time;
-        frames.push(ExecutedFrame { time_s, achieved, torque, error_rad, margin_m, departure_rad, assist });
+        frames.push(ExecutedFrame {
+            time_s,
+            achieved,
+            torque,
+            error_rad,
+            margin_m,
+            departure_rad,
+            assist,
+            feet_down,
+            take_feet_down,
+        });
     };
     record(0, &humanoid, torque, 0.0, Wrench::default());
     progress();
@@ -436,6 +464,7 @@ pub fn execute(
     let steps = (targets.frames() - 1) * steps_per_frame;
     // The first frame is where the humanoid was put, not where it went.
     let scored = if frames.len() > 1 { &frames[1..] } else { &frames[..] };
+    let before_fall = || scored.iter().take_while(|f| fell_at_s.is_none_or(|t| f.time_s < t));
     let errors = |j: Joint| scored.iter().map(move |f| f.error_rad[j.index()]);
     let rms_deg = |errors: &mut dyn Iterator<Item = f64>| {
         let (squares, count) = errors.fold((0.0, 0usize), |(s, c), e| (s + e * e, c + 1));
@@ -473,13 +502,10 @@ pub fn execute(
         start_raised_m: humanoid.raised_m(),
         feet_levelled_deg: feet_levelled_rad.map(|r| round6(r.to_degrees())),
         max_joint_gap_mm: max_joint_gap_m * 1e3,
-        min_balance_margin_m: scored
-            .iter()
-            .take_while(|f| fell_at_s.is_none_or(|t| f.time_s < t))
-            .filter_map(|f| f.margin_m)
-            .min_by(f64::total_cmp),
+        min_balance_margin_m: before_fall().filter_map(|f| f.margin_m).min_by(f64::total_cmp),
         departure_rms_deg: rms_deg(&mut scored.iter().map(|f| f.departure_rad)),
         departure_max_deg: max_deg(&mut scored.iter().map(|f| f.departure_rad)),
+        contact_agreement: contact_agreement(before_fall()),
         jerk_rms_m_s3: jerk_rms(&motion.body, &scored.iter().map(|f| f.achieved).collect::<Vec<_>>(), frame_time),
         assist: assist.then(|| {
             let mass = body_mass_kg(&motion.body);
@@ -666,7 +692,19 @@ impl Execution {
             }
             columns.push(format!("{}_error_deg", j.name()));
         }
-        columns.extend(["balance_margin_m", "departure_deg", "assist_force_n", "assist_torque_nm"].map(String::from));
+        columns.extend(
+            [
+                "balance_margin_m",
+                "departure_deg",
+                "assist_force_n",
+                "assist_torque_nm",
+                "left_foot_down",
+                "right_foot_down",
+                "take_left_foot_down",
+                "take_right_foot_down",
+            ]
+            .map(String::from),
+        );
         columns.join(",") + "\n"
     }
 
@@ -700,8 +738,19 @@ impl Execution {
         let margin = f.margin_m.map_or(String::new(), |m| format!("{m:.6}"));
         let (force, twist) = (f.assist.force.length(), f.assist.torque.length());
         write!(line, ",{margin},{:.4},{force:.3},{twist:.3}", f.departure_rad.to_degrees()).expect(INFALLIBLE);
+        let down = f.feet_down.map_or([String::new(), String::new()], |d| d.map(|on| u8::from(on).to_string()));
+        let [take_left, take_right] = f.take_feet_down.map(u8::from);
+        write!(line, ",{},{},{take_left},{take_right}", down[0], down[1]).expect(INFALLIBLE);
         line + "\n"
     }
+}
+
+/// The share of the feet on `frames` that touched the ground exactly when
+/// the take stood on them; `None` on a fixed base or without frames.
+fn contact_agreement<'a>(frames: impl Iterator<Item = &'a ExecutedFrame>) -> Option<f64> {
+    let feet = frames.filter_map(|f| Some(f.feet_down?.into_iter().zip(f.take_feet_down))).flatten();
+    let (agreeing, count) = feet.fold((0usize, 0usize), |(a, n), (down, take)| (a + usize::from(down == take), n + 1));
+    (count > 0).then(|| agreeing as f64 / count as f64)
 }
 
 /// The names of joint `j`'s joint-space numbers in `execution.csv`: a
@@ -729,6 +778,30 @@ mod tests {
             local[j.index()] = DQuat::from_rotation_x(each_deg.to_radians());
         }
         Pose::from_rotations(Pose::rest(body).root, &local)
+    }
+
+    #[test]
+    fn the_feet_agree_with_the_take_where_each_touches_the_ground_exactly_when_the_take_stands_on_it() {
+        let frame = |feet_down: Option<[bool; 2]>, take_feet_down: [bool; 2]| ExecutedFrame {
+            time_s: 0.0,
+            achieved: Pose::rest(&Body::standard()),
+            torque: [DVec3::ZERO; JOINTS],
+            error_rad: [0.0; JOINTS],
+            margin_m: None,
+            departure_rad: 0.0,
+            assist: Wrench::default(),
+            feet_down,
+            take_feet_down,
+        };
+        // Four feet of which three agree: one on the ground while the
+        // take holds it up.
+        let frames = [frame(Some([true, true]), [true, false]), frame(Some([true, false]), [true, false])];
+        assert_eq!(contact_agreement(frames.iter()), Some(0.75));
+        // A foot held up where the take stands on it disagrees too.
+        assert_eq!(contact_agreement([frame(Some([false, true]), [true, true])].iter()), Some(0.5));
+        // On a stand, or without frames, there is nothing to agree.
+        assert_eq!(contact_agreement([frame(None, [true, true])].iter()), None);
+        assert_eq!(contact_agreement([].iter()), None);
     }
 
     #[test]

@@ -124,6 +124,12 @@ fn the_summary_is_the_table_and_executed_bvh_is_what_the_table_says_the_humanoid
     let source = read_motion(&takes.join("punch.bvh"));
     assert_eq!(rows.len(), source.poses.len());
     assert_eq!(number(&s, "frames") as usize, rows.len());
+    // On a stand no foot touches any ground: the humanoid's feet columns
+    // are empty and their agreement with the take's contacts is not given.
+    for foot in ["left_foot_down", "right_foot_down"] {
+        assert!(rows.iter().all(|r| r[column(&header, foot)].is_nan()), "{foot}");
+    }
+    assert!(s["contact_agreement"].is_null(), "{s}");
 
     // The overall RMS is over every actuated joint's error column, from the
     // second frame (the first is where the humanoid was put).
@@ -186,6 +192,13 @@ fn standing_on_the_ground_a_waving_humanoid_stays_up_and_one_leaning_back_falls_
     assert!(least > 0.0 && (least - number(&s, "min_balance_margin_m")).abs() < 1e-6, "{least} against {s}");
     let most = rows[1..].iter().map(|r| r[departure]).fold(0.0, f64::max);
     assert!(most > 0.0 && (most - number(&s, "departure_max_deg")).abs() < 1e-3, "{most} against {s}");
+    // Both feet stand throughout, the humanoid's as the take's (from the
+    // second frame: the first is where the humanoid was put, before the
+    // physics found its contacts).
+    let feet = ["left_foot_down", "right_foot_down", "take_left_foot_down", "take_right_foot_down"];
+    assert!(rows[1..].iter().all(|r| feet.iter().all(|f| r[column(&header, f)] == 1.0)));
+    assert!(feet[..2].iter().all(|f| rows[0][column(&header, f)].is_nan()));
+    assert_eq!(number(&s, "contact_agreement"), 1.0, "{s}");
 
     // The feet turned 45° toe-down within a second, the legs straight:
     // standing flat, the body leans back with its centre of mass far behind
@@ -210,6 +223,16 @@ fn standing_on_the_ground_a_waving_humanoid_stays_up_and_one_leaning_back_falls_
     let (time, margin) = (column(&header, "time_s"), column(&header, "balance_margin_m"));
     let before = rows[1..].iter().filter(|r| r[time] < at).map(|r| r[margin]).fold(f64::INFINITY, f64::min);
     assert!((before - number(&s, "min_balance_margin_m")).abs() < 1e-6, "{before} against {s}");
+    // So is the feet's agreement with the take's contacts: the share of
+    // the feet that touched the ground exactly when the take stood on them.
+    let pairs = [("left_foot_down", "take_left_foot_down"), ("right_foot_down", "take_right_foot_down")];
+    let feet: Vec<bool> = rows[1..]
+        .iter()
+        .filter(|r| r[time] < at)
+        .flat_map(|r| pairs.map(|(mine, take)| r[column(&header, mine)] == r[column(&header, take)]))
+        .collect();
+    let agreeing = feet.iter().filter(|&&a| a).count() as f64 / feet.len() as f64;
+    assert!((agreeing - number(&s, "contact_agreement")).abs() < 1e-6, "{agreeing} against {s}");
     assert!(s["assist"].is_null() && rows.iter().all(|r| r[column(&header, "assist_force_n")] == 0.0));
 
     // Assisted, the same take stays up; the pull is in every frame's row

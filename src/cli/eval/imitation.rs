@@ -153,8 +153,9 @@ pub(super) fn table(work: &Work, synthetic: &Path, run: &Path, truth: &Path, rea
         about: format!(
             "Each take played by `imitate execute` with its defaults ({rate} Hz, a first frame that is a bind pose \
              left out, but not from the tracked run, imitated frame for frame): on a stand (fixed base), standing on the ground with balance and stepping, and on the ground with \
-             `--assist` (the mean pull as a share of body weight); RMS joint error against the take's targets, and \
-             when it fell. Trial one's run (6 particles, its first seed) is also imitated by its primitives \
+             `--assist` (the mean pull as a share of body weight); RMS joint error against the take's targets, \
+             when it fell, and on the ground how closely the feet followed the take's own contacts (the share of \
+             the feet that touched the ground exactly when the take stood on them, before any fall). Trial one's run (6 particles, its first seed) is also imitated by its primitives \
              (`--primitives --truth`, standing): the upper body's root-relative error against the truth and the jerk, \
              against its trajectory played as it is.{real_note}",
             rate = ExecuteParams::DEFAULT_RATE_HZ
@@ -174,11 +175,13 @@ pub(super) fn table(work: &Work, synthetic: &Path, run: &Path, truth: &Path, rea
     })
 }
 
-/// An execution on the ground: its RMS error and whether and when it fell.
+/// An execution on the ground: its RMS error, whether and when it fell,
+/// and how closely its feet followed the take's contacts.
 fn ground_cell(summary: &Summary) -> String {
+    let feet = summary.contact_agreement.map_or(String::new(), |a| format!("; feet {:.0}%", 100.0 * a));
     match summary.fell_at_s {
-        Some(t) => format!("{:.2}, fell at {t:.1} s", summary.rms_error_deg),
-        None => format!("{:.2}, stayed up", summary.rms_error_deg),
+        Some(t) => format!("{:.2}, fell at {t:.1} s{feet}", summary.rms_error_deg),
+        None => format!("{:.2}, stayed up{feet}", summary.rms_error_deg),
     }
 }
 
@@ -188,5 +191,6 @@ fn figures(summary: &Summary) -> Value {
         "max_error_deg": summary.max_error_deg,
         "fell_at_s": summary.fell_at_s,
         "jerk_rms_m_s3": summary.jerk_rms_m_s3,
+        "contact_agreement": summary.contact_agreement,
     })
 }
