@@ -26,6 +26,8 @@ pub struct ExecutionSummary {
     pub min_balance_margin_m: Option<f64>,
     #[serde(default)]
     pub assist: Option<AssistRow>,
+    #[serde(default)]
+    pub contact_agreement: Option<f64>,
     pub joints: Vec<JointRow>,
 }
 
@@ -54,7 +56,8 @@ pub struct Imitation {
     pub humanoid: Track,
     /// From `execution.csv`: each frame's time and its balance columns
     /// (`balance_margin_m`, `departure_deg`, `assist_force_n`), those the
-    /// file has.
+    /// file has, and how many of the feet touched the ground exactly when
+    /// the take stood on them (`FEET_AGREEING`, from the feet columns).
     pub time_s: Vec<f64>,
     pub balance: Curves,
 }
@@ -102,6 +105,17 @@ pub fn read_imitation(dir: &Path, run: &Track) -> Result<Imitation, ReportError>
             balance.push((name.to_string(), values));
         }
     }
+    let mut feet = Vec::with_capacity(FEET_COLUMNS.len());
+    for name in FEET_COLUMNS {
+        feet.extend(table.column(name)?);
+    }
+    if let [left, right, take_left, take_right] = &feet[..] {
+        let agreeing = (0..times.len()).map(|k| {
+            let pairs = [(left[k]?, take_left[k]?), (right[k]?, take_right[k]?)];
+            Some(pairs.iter().filter(|(down, take)| down == take).count() as f64)
+        });
+        balance.push((FEET_AGREEING.to_string(), agreeing.collect()));
+    }
     let frames: Vec<_> = motion.poses.iter().map(|p| motion.body.forward(p)).collect();
     let humanoid = Track {
         file,
@@ -116,6 +130,11 @@ pub fn read_imitation(dir: &Path, run: &Track) -> Result<Imitation, ReportError>
 
 /// The columns of `execution.csv` the balance figure draws.
 const BALANCE_COLUMNS: [&str; 3] = ["balance_margin_m", "departure_deg", "assist_force_n"];
+/// The feet columns of `execution.csv` (absent in executions written
+/// before them): the humanoid's left and right, then the take's.
+const FEET_COLUMNS: [&str; 4] = ["left_foot_down", "right_foot_down", "take_left_foot_down", "take_right_foot_down"];
+/// The balance figure's curve drawn from them.
+const FEET_AGREEING: &str = "feet_agreeing";
 
 impl Imitation {
     /// One sentence: how the humanoid was held and how it followed.
@@ -142,7 +161,13 @@ impl Imitation {
             }
             (None, Some(m)) => format!(" Its capture point stayed at least {:.0} mm inside its feet.", 1e3 * m),
             (None, None) => String::new(),
-        }
+        } + &s.contact_agreement.map_or(String::new(), |a| {
+            format!(
+                " Its feet touched the ground exactly when the trajectory stood on them {:.0}% of the time{}.",
+                100.0 * a,
+                if s.fell_at_s.is_some() { " before it fell" } else { "" }
+            )
+        })
     }
 
     /// The balance over time, one panel per column the execution has that
@@ -157,6 +182,9 @@ impl Imitation {
                 let (title, unit) = match name.as_str() {
                     "balance_margin_m" => ("balance margin: the capture point inside the support polygon", "m"),
                     "departure_deg" => ("departure: the most the balance turned a joint from the trajectory", "°"),
+                    FEET_AGREEING => {
+                        ("feet: how many touch the ground exactly when the trajectory stands on them", "feet")
+                    }
                     _ => ("assistance: the pull on the pelvis", "N"),
                 };
                 let points = self
