@@ -152,11 +152,13 @@ pub(super) fn table(work: &Work, synthetic: &Path, run: &Path, truth: &Path, rea
         title: "Imitation: the takes played on the simulated humanoid".into(),
         about: format!(
             "Each take played by `imitate execute` with its defaults ({rate} Hz, a first frame that is a bind pose \
-             left out, but not from the tracked run, imitated frame for frame): on a stand (fixed base), standing on the ground with balance and stepping, and on the ground with \
+             left out, but not from the tracked run, imitated frame for frame): on a stand (fixed base), standing \
+             on the ground with balance and stepping, and on the ground with \
              `--assist` (the mean pull as a share of body weight); RMS joint error against the take's targets, \
              when it fell, and on the ground how closely the feet followed the take's own contacts (the share of \
-             the feet that touched the ground exactly when the take stood on them, before any fall). Trial one's run (6 particles, its first seed) is also imitated by its primitives \
-             (`--primitives --truth`, standing): the upper body's root-relative error against the truth and the jerk, \
+             the feet that touched the ground exactly when the take stood on them, before any fall). Trial one's \
+             run (6 particles, its first seed) is also imitated by its primitives (`--primitives --truth`, \
+             standing): the upper body's root-relative error against the truth and the jerk, \
              against its trajectory played as it is.{real_note}",
             rate = ExecuteParams::DEFAULT_RATE_HZ
         ),
