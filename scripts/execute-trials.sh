@@ -63,7 +63,7 @@ while IFS=, read -r file activity _; do
 done <"$real/labels.csv"
 
 python3 - "${flags[*]:-}" <<'PY'
-import json, sys
+import json, statistics, sys
 from pathlib import Path
 
 flags = sys.argv[1]
@@ -100,8 +100,7 @@ for group in sorted(Path("runs").iterdir()):
     share = 100 * up / played if played else 0
     refused_note = f"; refused: {', '.join(refused)}" if refused else ""
     shares.sort()
-    agreement.sort()
-    feet = f"{100 * agreement[len(agreement) // 2]:.0f}%" if agreement else "—"
+    feet = f"{100 * statistics.median(agreement):.0f}%" if agreement else "—"
     pull = f"{100 * shares[len(shares) // 2]:.0f}%, {100 * shares[-1]:.0f}% | " if shares else ("— | " if assisted else "")
     lines.append(f"| {group.name} | {played} | {up} ({share:.0f}%) | {where_up} | {feet} | {pull}"
                  f"{'; '.join(falls) or '—'}{refused_note} |")
