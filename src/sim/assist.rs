@@ -195,7 +195,7 @@ mod tests {
             let mut asked = targets;
             let shift = humanoid.balance(&mut asked, None);
             humanoid.assist_toward(&root, DVec3::ZERO, if follow { shift } else { DVec3::ZERO });
-            humanoid.step(&asked, Gains::STANDARD);
+            humanoid.step(&asked, Gains::STANDARD, false);
             if k >= steps - last {
                 let force = humanoid.assist_wrench().force;
                 sum += DVec3::new(force.x, 0.0, force.z).length();
@@ -210,7 +210,7 @@ mod tests {
     fn turning_stiffness(tilt_deg: f64) -> f64 {
         let (mut humanoid, root) = assisted_at_rest(tilt_deg);
         // A step to find the feet on the ground.
-        humanoid.step(&[JointTarget::REST; JOINTS], Gains::STANDARD);
+        humanoid.step(&[JointTarget::REST; JOINTS], Gains::STANDARD, false);
         humanoid.assist_toward(&root, DVec3::ZERO, DVec3::ZERO);
         let (_, handle) = humanoid.anchor.unwrap();
         let joint = &humanoid.world.impulse_joints.get(handle).unwrap().data;

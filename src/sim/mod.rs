@@ -5,6 +5,7 @@
 pub mod anthropometry;
 pub mod assist;
 pub mod balance;
+pub mod bind_pose;
 pub mod execute;
 pub mod humanoid;
 pub mod stepping;
