@@ -418,10 +418,10 @@ pub fn execute(
             played.sample(time_s, &mut asked);
             let mut balance_shift = DVec3::ZERO;
             let stepping = balance && contacts.stepping(time_s);
+            let root = played.root_at(time_s);
             if balance {
                 let mut wanted = asked;
                 targets.sample(time_s, &mut wanted);
-                let root = played.root_at(time_s);
                 contacts.lift_swing_feet(&motion.body, root.rotation, time_s, &mut asked);
                 match contacts.single_stance(time_s) {
                     // The swing starts when the humanoid's own foot has left
@@ -443,7 +443,7 @@ pub fn execute(
                     .fold(0.0, f64::max);
             }
             if assist {
-                humanoid.assist_toward(&played.root_at(time_s), offset, balance_shift);
+                humanoid.assist_toward(&root, offset, balance_shift);
             }
             humanoid.step(&asked, gains, stepping);
             if let Some((joint, speed_m_s, spin_rad_s)) = humanoid.runaway() {

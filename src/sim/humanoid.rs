@@ -365,14 +365,12 @@ impl Humanoid {
     /// with `STEPPING_LEG_SHARE` of the natural frequency.
     pub fn step(&mut self, targets: &[JointTarget; JOINTS], gains: Gains, stepping: bool) {
         let dt = f64::from(self.world.integration_parameters.dt);
-        let turned = self.turned_inertia();
-        let soft = FEET.map(|foot| stepping && self.stands(foot));
+        let standing = FEET.map(|foot| self.stands(foot));
+        let turned = self.turned_inertia(standing);
         for actuator in &self.actuators {
             let j = actuator.joint;
-            let gains = match foot_of(j) {
-                Some(foot) if soft[usize::from(foot == Joint::RightAnkle)] => gains.slowed(STEPPING_LEG_SHARE),
-                _ => gains,
-            };
+            let holds_up = leg_of(j).is_some_and(|leg| standing[leg]);
+            let gains = if stepping && holds_up { gains.slowed(STEPPING_LEG_SHARE) } else { gains };
             let parent = self.rotation(j.parent().expect("only the pelvis has no parent"));
             let target = targets[j.index()];
             let data = &mut self.world.impulse_joints.get_mut(actuator.handle, false).expect(JOINT).data;
@@ -406,7 +404,8 @@ impl Humanoid {
     /// The inertia tensor (world axes, about the joint) of what each
     /// joint's motors turn: the links it carries, or, on a leg whose foot
     /// stands on the ground, the rest of the body, which that leg holds up.
-    fn turned_inertia(&self) -> [DMat3; JOINTS] {
+    /// `standing` says which feet (left, right) stand.
+    fn turned_inertia(&self, standing: [bool; 2]) -> [DMat3; JOINTS] {
         let placed = Joint::ALL.map(|j| {
             let rigid = &self.world.bodies[self.links[j.index()]];
             let rotation = to_f64(*rigid.rotation());
@@ -419,11 +418,10 @@ impl Humanoid {
                 sum + self.inertials[c.index()].tensor_about(rotation, com - at)
             })
         };
-        let standing = FEET.map(|foot| self.stands(foot));
         Joint::ALL.map(|j| {
             let at = placed[j.index()].0;
             let carried = about(at, &mut self.carried[j.index()].iter().copied());
-            let holds_up = foot_of(j).is_some_and(|foot| standing[usize::from(foot == Joint::RightAnkle)]);
+            let holds_up = leg_of(j).is_some_and(|leg| standing[leg]);
             if holds_up { about(at, &mut Joint::ALL.into_iter()) - carried } else { carried }
         })
     }
@@ -554,12 +552,13 @@ fn motor_axes(j: Joint, target: DQuat) -> [DVec3; 3] {
     }
 }
 
-/// The foot at the end of the leg `j` belongs to, if it is a leg joint.
-fn foot_of(j: Joint) -> Option<Joint> {
+/// The leg `j` belongs to (0 left, 1 right, as `FEET`), if it is a leg
+/// joint.
+fn leg_of(j: Joint) -> Option<usize> {
     use Joint::*;
     match j {
-        LeftHip | LeftKnee | LeftAnkle => Some(LeftAnkle),
-        RightHip | RightKnee | RightAnkle => Some(RightAnkle),
+        LeftHip | LeftKnee | LeftAnkle => Some(0),
+        RightHip | RightKnee | RightAnkle => Some(1),
         _ => None,
     }
 }

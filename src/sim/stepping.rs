@@ -48,6 +48,12 @@ pub struct Contacts {
     frame_time_s: f64,
     standing: Vec<[bool; 2]>,
     ankles: Vec<[DVec3; 2]>,
+    /// Per frame, whether the take stands on one foot within
+    /// `STEPPING_WITHIN_S` of it.
+    stepping: Vec<bool>,
+    /// Per frame and foot, the swing it is in: the last frame the foot
+    /// stood on before and the first it stands on after.
+    swings: Vec<[Option<(usize, usize)>; 2]>,
 }
 
 impl Contacts {
@@ -84,8 +90,16 @@ impl Contacts {
                     ankles[k][f].y < standing_y[f] + CONTACT_RISE_M && speed < CONTACT_SPEED_M_S
                 })
             })
-            .collect();
-        Contacts { frame_time_s: dt, standing, ankles }
+            .collect::<Vec<_>>();
+        let reach = (STEPPING_WITHIN_S / dt).round() as usize;
+        let stepping = within_reach(&standing.iter().map(|s| s[0] != s[1]).collect::<Vec<_>>(), reach);
+        let swings = swings(&standing);
+        Contacts { frame_time_s: dt, standing, ankles, stepping, swings }
+    }
+
+    /// The frame nearest `time_s`.
+    fn frame_at(&self, time_s: f64) -> usize {
+        ((time_s / self.frame_time_s).max(0.0).round() as usize).min(self.standing.len() - 1)
     }
 
     /// Which of the take's feet (left, right) stand on frame `k`.
@@ -98,7 +112,7 @@ impl Contacts {
     pub fn single_stance(&self, time_s: f64) -> Option<(usize, DVec3)> {
         let at = (time_s / self.frame_time_s).max(0.0);
         let last = self.standing.len() - 1;
-        let foot = match self.standing[(at.round() as usize).min(last)] {
+        let foot = match self.standing[self.frame_at(time_s)] {
             [true, false] => 0,
             [false, true] => 1,
             _ => return None,
@@ -110,10 +124,7 @@ impl Contacts {
     /// Whether the take stands on one foot within `STEPPING_WITHIN_S` of
     /// `time_s`.
     pub fn stepping(&self, time_s: f64) -> bool {
-        let reach = (STEPPING_WITHIN_S / self.frame_time_s).round() as usize;
-        let at = ((time_s / self.frame_time_s).max(0.0).round() as usize).min(self.standing.len() - 1);
-        let within = &self.standing[at.saturating_sub(reach)..=(at + reach).min(self.standing.len() - 1)];
-        within.iter().any(|s| s[0] != s[1])
+        self.stepping[self.frame_at(time_s)]
     }
 
     /// How far through its swing the take's foot `f` (0 left, 1 right) is
@@ -123,17 +134,8 @@ impl Contacts {
     /// read as lifted for a frame or two while it stands: the demo's
     /// tracked trajectory, lifted there, bent both knees 6° off).
     fn swing_share(&self, time_s: f64, f: usize) -> Option<f64> {
+        let (lifted, lands) = self.swings[self.frame_at(time_s)][f]?;
         let at = (time_s / self.frame_time_s).max(0.0);
-        let last = self.standing.len() - 1;
-        let k = (at.round() as usize).min(last);
-        if self.standing[k][f] {
-            return None;
-        }
-        let lifted = (0..k).rev().find(|&j| self.standing[j][f])?;
-        let lands = (k + 1..=last).find(|&j| self.standing[j][f])?;
-        if !(lifted + 1..lands).any(|j| self.standing[j][1 - f]) {
-            return None;
-        }
         Some(((at - lifted as f64) / (lands - lifted) as f64).clamp(0.0, 1.0))
     }
 
@@ -235,6 +237,41 @@ impl Humanoid {
             hip.rotation = clamp(HIPS[k], now.inverse() * tilt * now * hip.rotation).0;
         }
     }
+}
+
+/// Per entry of `marks`, whether any entry within `reach` of it is set.
+fn within_reach(marks: &[bool], reach: usize) -> Vec<bool> {
+    // How many are set before each entry.
+    let before: Vec<usize> = std::iter::once(0)
+        .chain(marks.iter().scan(0, |sum, &m| {
+            *sum += usize::from(m);
+            Some(*sum)
+        }))
+        .collect();
+    let last = marks.len().saturating_sub(1);
+    (0..marks.len()).map(|k| before[(k + reach).min(last) + 1] > before[k.saturating_sub(reach)]).collect()
+}
+
+/// Per frame and foot, the swing it is in (see [`Contacts`]'s `swings`):
+/// only between two frames the foot stands on, with the other foot
+/// standing on one in between ([`Contacts::swing_share`] says why).
+fn swings(standing: &[[bool; 2]]) -> Vec<[Option<(usize, usize)>; 2]> {
+    let mut swings = vec![[None; 2]; standing.len()];
+    for f in 0..2 {
+        let mut stood = None;
+        for (k, s) in standing.iter().enumerate() {
+            if !s[f] {
+                continue;
+            }
+            if let Some(lifted) = stood.filter(|&l| (l + 1..k).any(|j| standing[j][1 - f])) {
+                for swing in &mut swings[lifted + 1..k] {
+                    swing[f] = Some((lifted, k));
+                }
+            }
+            stood = Some(k);
+        }
+    }
+    swings
 }
 
 /// Raises foot `f`'s ankle (0 left, 1 right) in `targets` by `lift_m`
