@@ -177,9 +177,10 @@ def execute(
     ``skip`` leaves out the first frames (by default the first one when it
     is a bind pose, as ``imitate execute`` does, with a ``UserWarning``;
     ``skip=0`` keeps it; a first frame off the floor is warned of too);
-    ``assist`` pulls the pelvis toward the trajectory's with a residual
-    force and torque, reported in the table (``assist_force_n``,
-    ``assist_torque_nm``). With ``primitives`` (a ``track`` run folder, in
+    ``assist`` holds the humanoid up with a residual force (keeping the
+    capture point over the feet) and torque (turning the pelvis toward the
+    trajectory's) on the pelvis, reported in the table
+    (``assist_force_n``, ``assist_torque_nm``). With ``primitives`` (a ``track`` run folder, in
     place of ``motion``) the run's trajectory is imitated by its
     vocabulary's primitives, as ``imitate execute --primitives`` does,
     scored against ``truth`` (a truth.csv) when given. With

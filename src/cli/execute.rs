@@ -53,9 +53,11 @@ pub struct Args {
     /// over them, stepping when the take stands on one foot).
     #[arg(long)]
     pub no_balance: bool,
-    /// On a free base, pull the pelvis toward the trajectory's with a
-    /// residual force and torque where the joints cannot follow it (walks,
-    /// jumps): written per frame and summarized, never hidden.
+    /// On a free base, hold the humanoid up with a residual force and
+    /// torque on the pelvis where its joints cannot (walks, jumps): a push
+    /// that keeps the capture point over the feet and a torque that turns
+    /// the pelvis toward the trajectory's, written per frame and
+    /// summarized, never hidden.
     #[arg(long)]
     pub assist: bool,
     /// Motor stiffness and damping per unit of the inertia each joint

@@ -36,6 +36,8 @@ pub struct AssistRow {
     pub mean_force_n: f64,
     pub max_force_n: f64,
     pub mean_force_share_of_weight: f64,
+    pub mean_torque_nm: f64,
+    pub max_torque_nm: f64,
 }
 
 #[derive(Debug, Clone, serde::Deserialize)]
@@ -55,9 +57,10 @@ pub struct Imitation {
     pub summary: ExecutionSummary,
     pub humanoid: Track,
     /// From `execution.csv`: each frame's time and its balance columns
-    /// (`balance_margin_m`, `departure_deg`, `assist_force_n`), those the
-    /// file has, and how many of the feet touched the ground exactly when
-    /// the take stood on them (`FEET_AGREEING`, from the feet columns).
+    /// (`balance_margin_m`, `departure_deg`, `assist_force_n`,
+    /// `assist_torque_nm`), those the file has, and how many of the feet
+    /// touched the ground exactly when the take stood on them
+    /// (`FEET_AGREEING`, from the feet columns).
     pub time_s: Vec<f64>,
     pub balance: Curves,
 }
@@ -129,7 +132,7 @@ pub fn read_imitation(dir: &Path, run: &Track) -> Result<Imitation, ReportError>
 }
 
 /// The columns of `execution.csv` the balance figure draws.
-const BALANCE_COLUMNS: [&str; 3] = ["balance_margin_m", "departure_deg", "assist_force_n"];
+const BALANCE_COLUMNS: [&str; 4] = ["balance_margin_m", "departure_deg", "assist_force_n", "assist_torque_nm"];
 /// The feet columns of `execution.csv` (absent in executions written
 /// before them): the humanoid's left and right, then the take's.
 const FEET_COLUMNS: [&str; 4] = ["left_foot_down", "right_foot_down", "take_left_foot_down", "take_right_foot_down"];
@@ -151,10 +154,13 @@ impl Imitation {
             s.rate_hz, s.rms_error_deg, s.max_error_deg
         ) + &match (&s.assist, s.min_balance_margin_m) {
             (Some(a), _) => format!(
-                " It was assisted: a pull on its pelvis of {:.0} N on average ({:.1}% of its weight), {:.0} N at most.",
+                " It was assisted: a push on its pelvis of {:.0} N on average ({:.1}% of its weight), {:.0} N at \
+                 most, and a torque turning it of {:.0} N·m on average, {:.0} N·m at most.",
                 a.mean_force_n,
                 100.0 * a.mean_force_share_of_weight,
-                a.max_force_n
+                a.max_force_n,
+                a.mean_torque_nm,
+                a.max_torque_nm
             ),
             (None, Some(m)) if m < 0.0 => {
                 format!(" Its capture point left its feet by up to {:.0} mm (a negative balance margin).", -1e3 * m)
@@ -172,7 +178,9 @@ impl Imitation {
 
     /// The balance over time, one panel per column the execution has that
     /// says something (a fixed base has no margin; without assistance the
-    /// force is zero throughout): `None` when none does.
+    /// force and torque are zero throughout, and an assisted humanoid whose
+    /// capture point never left its feet was never pushed): `None` when
+    /// none does.
     pub fn balance_figure(&self, width: u32) -> Option<Figure> {
         let panels: Vec<Chart> = self
             .balance
@@ -185,7 +193,8 @@ impl Imitation {
                     FEET_AGREEING => {
                         ("feet: how many touch the ground exactly when the trajectory stands on them", "feet")
                     }
-                    _ => ("assistance: the pull on the pelvis", "N"),
+                    "assist_force_n" => ("assistance: the push on the pelvis", "N"),
+                    _ => ("assistance: the torque turning the pelvis", "N·m"),
                 };
                 let points = self
                     .time_s

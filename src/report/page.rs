@@ -157,7 +157,8 @@ pub fn run_report(
                 "the humanoid's balance over time",
                 "How far the capture point (where the body would come to rest without stepping) lay inside the \
                  support polygon of the feet on the ground, negative outside; how far the balance turned the targets \
-                 away from the trajectory to stay up; and, when assisted, the force pulling the pelvis.",
+                 away from the trajectory to stay up; and, when assisted, the force pushing the pelvis and the torque \
+                 turning it.",
             );
             files.push(("balance.png".into(), png));
             files.push(("balance.svg".into(), svg.into_bytes()));

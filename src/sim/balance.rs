@@ -44,6 +44,10 @@ pub struct BalanceState {
     /// inverted pendulum's frequency √(g/h), where the body comes to rest
     /// over if it does not step.
     pub capture: DVec2,
+    /// The centre of mass's height over the standing soles (over the
+    /// ground while no foot stands), at least 0.1 m: the inverted
+    /// pendulum's length.
+    pub height_m: f64,
     /// The support polygon: the convex hull of the sole corners on the
     /// ground; empty while no foot stands.
     pub support: Vec<DVec2>,
@@ -65,6 +69,13 @@ impl BalanceState {
 }
 
 impl Humanoid {
+    /// The corners of foot `k`'s sole (0 left, 1 right) in the world.
+    pub(super) fn sole(&self, k: usize) -> [DVec3; 4] {
+        let ankle = &self.world.bodies[self.links[FEET[k].index()]];
+        let (at, turn) = (ankle.translation().as_dvec3(), to_f64(*ankle.rotation()));
+        self.soles[k].map(|c| at + turn * c)
+    }
+
     /// The centre of mass, its velocity, the capture point and the support
     /// polygon now.
     pub fn balance_state(&self) -> BalanceState {
@@ -83,21 +94,20 @@ impl Humanoid {
             if !self.stands(foot) {
                 continue;
             }
-            let ankle = &self.world.bodies[self.links[foot.index()]];
-            let (at, turn) = (ankle.translation().as_dvec3(), to_f64(*ankle.rotation()));
-            let sole = self.soles[k].map(|c| at + turn * c);
+            let sole = self.sole(k);
             sole_middles[k] = Some(sole.iter().sum::<DVec3>() / 4.0);
             corners.extend(sole.iter().filter(|c| c.y < CONTACT_M).map(|c| DVec2::new(c.x, c.z)));
         }
         let (sum, standing) = sole_middles.iter().flatten().fold((DVec3::ZERO, 0), |(sum, n), &m| (sum + m, n + 1));
         let stance_centre = (standing > 0).then(|| sum / f64::from(standing));
         let ground = stance_centre.map_or(0.0, |c| c.y);
-        let height = (com.y - ground).max(0.1);
-        let ahead = com + velocity / (GRAVITY_M_S2 / height).sqrt();
+        let height_m = (com.y - ground).max(0.1);
+        let ahead = com + velocity / (GRAVITY_M_S2 / height_m).sqrt();
         BalanceState {
             com,
             velocity,
             capture: DVec2::new(ahead.x, ahead.z),
+            height_m,
             support: convex_hull(corners),
             stance_centre,
             sole_middles,
@@ -117,12 +127,11 @@ impl Humanoid {
     /// strategy alone) cannot shift it sideways while both feet stand, as
     /// turning about one ankle's forward axis lifts the other foot (measured: 1
     /// of 23 real captures stayed up that way, falling sideways with the ankles
-    /// at their tilt limit). Nothing changes while no foot stands. Returns how
-    /// far (m, world axes) the turn asks the pelvis to move.
-    pub fn balance(&self, targets: &mut [JointTarget; JOINTS], onto: Option<usize>) -> DVec3 {
+    /// at their tilt limit). Nothing changes while no foot stands.
+    pub fn balance(&self, targets: &mut [JointTarget; JOINTS], onto: Option<usize>) {
         let state = self.balance_state();
         let Some(support) = onto.and_then(|k| state.sole_middles[k]).or(state.stance_centre) else {
-            return DVec3::ZERO;
+            return;
         };
         let shift = CAPTURE_GAIN * DVec3::new(support.x - state.capture.x, 0.0, support.z - state.capture.y);
         // Turning a leg by θ about its ankle moves its hip, h above it, by
@@ -139,7 +148,6 @@ impl Humanoid {
             let (hip, thigh) = (HIPS[k], &mut targets[HIPS[k].index()]);
             thigh.rotation = clamp(hip, pelvis.inverse() * turn * pelvis * thigh.rotation).0;
         }
-        hip_height * tilt.cross(DVec3::Y)
     }
 
     /// Asks standing foot `k`'s sole to stay halfway between where the

@@ -29,8 +29,8 @@ pub struct ExecuteParams {
     /// of mass over them ([`Humanoid::balance`]), stepping where the take
     /// stands on one foot.
     pub balance: bool,
-    /// On a free base, pull the pelvis toward the trajectory's with a
-    /// residual force and torque ([`super::assist`]), reported.
+    /// On a free base, hold the humanoid up with a residual force and
+    /// torque on the pelvis ([`super::assist`]), reported.
     pub assist: bool,
     pub gains: Gains,
     /// Physics steps a second; rounded up to a whole number of steps per
@@ -276,7 +276,7 @@ pub struct Playback {
     pub fell_at_s: Option<f64>,
 }
 
-/// How hard the assistance pulled, over every physics step.
+/// How hard the assistance pushed and turned, over every physics step.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct AssistSummary {
     #[serde(serialize_with = "rounded")]
@@ -376,8 +376,6 @@ pub fn execute(
     let standing = motion.body.pelvis_height();
 
     let mut frames = Vec::with_capacity(targets.frames());
-    // Where the humanoid's pelvis was put against the trajectory's.
-    let offset = humanoid.frame().position(Joint::Pelvis) - played.pose(0).root;
     if base == Base::Free {
         humanoid.launch(&played.root_at(0.0));
     }
@@ -416,7 +414,6 @@ pub fn execute(
         for s in 1..=steps_per_frame {
             let time_s = (k - 1) as f64 * frame_time + s as f64 * dt;
             played.sample(time_s, &mut asked);
-            let mut balance_shift = DVec3::ZERO;
             let stepping = balance && contacts.stepping(time_s);
             let root = played.root_at(time_s);
             if balance {
@@ -432,7 +429,7 @@ pub fn execute(
                         humanoid.step_over(&mut asked, stance, ankle, &root)
                     }
                     stance => {
-                        balance_shift = humanoid.balance(&mut asked, stance.map(|(foot, _)| foot));
+                        humanoid.balance(&mut asked, stance.map(|(foot, _)| foot));
                         if stance.is_some() {
                             humanoid.hold_trunk(&mut asked, root.rotation);
                         }
@@ -443,7 +440,7 @@ pub fn execute(
                     .fold(0.0, f64::max);
             }
             if assist {
-                humanoid.assist_toward(&root, offset, balance_shift);
+                humanoid.assist_toward(&root);
             }
             humanoid.step(&asked, gains, stepping);
             if let Some((joint, speed_m_s, spin_rad_s)) = humanoid.runaway() {

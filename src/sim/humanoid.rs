@@ -155,11 +155,10 @@ pub struct Humanoid {
     /// The corners of each foot's sole (left, right) in its ankle's frame.
     pub(super) soles: [[DVec3; 4]; 2],
     /// With assistance, the body that carries the trajectory's pelvis and
-    /// the spring joint from it to the pelvis ([`super::assist`]).
+    /// the turning spring from it to the pelvis ([`super::assist`]).
     pub(super) anchor: Option<(RigidBodyHandle, ImpulseJointHandle)>,
-    /// Where the assistance's far end is moved from the trajectory's
-    /// pelvis, following the balance ([`Humanoid::assist_toward`]).
-    pub(super) assist_shift: DVec3,
+    /// The assistance's push on the pelvis in the step under way, N.
+    pub(super) assist_force: DVec3,
 }
 
 /// Stiffness and damping of every motor per unit of the inertia it turns.
@@ -283,7 +282,7 @@ impl Humanoid {
             offsets,
             soles,
             anchor: None,
-            assist_shift: DVec3::ZERO,
+            assist_force: DVec3::ZERO,
         };
         humanoid.set_velocities(start);
         humanoid

@@ -117,20 +117,22 @@ fn a_run_becomes_a_self_contained_page_whose_numbers_are_those_of_metrics_json()
     // On a stand there is no balance to show.
     assert!(!dir.join("imitation/balance.png").exists());
     // Standing on the ground with assistance, the balance over time: the
-    // margin, the departure, the pull and the feet that touch the ground
-    // as the trajectory's stand, one panel each.
+    // margin, the departure, the assistance's torque, its push when it
+    // pushed, and the feet that touch the ground as the trajectory's stand,
+    // one panel each.
     ok(run(dir, &["execute", "run/trajectory.bvh", "-o", "standing", "--assist", "--skip", "0"]));
     ok(run(dir, &["report", "run", "--execution", "standing", "-o", "assisted"]));
     let html = fs::read_to_string(dir.join("assisted/index.html")).unwrap();
-    assert!(html.contains("It was assisted: a pull on its pelvis of"), "the assistance is said");
+    assert!(html.contains("It was assisted: a push on its pelvis of"), "the assistance is said");
     let execution: serde_json::Value =
         serde_json::from_slice(&fs::read(dir.join("standing/summary.json")).unwrap()).unwrap();
     let agreement = 100.0 * execution["contact_agreement"].as_f64().unwrap();
     let feet =
         format!("Its feet touched the ground exactly when the trajectory stood on them {agreement:.0}% of the time");
     assert!(html.contains(&feet), "{feet}");
+    let pushed = execution["assist"]["max_force_n"].as_f64().unwrap() > 0.0;
     let balance = image::open(dir.join("assisted/balance.png")).unwrap();
-    assert_eq!(balance.height(), 4 * 180, "four panels");
+    assert_eq!(balance.height(), (4 + u32::from(pushed)) * 180, "four panels, five when pushed");
 
     // A baseline run has no primitives' curves: the page says so and still
     // shows the error and the filmstrip.

@@ -94,13 +94,14 @@ pub(super) fn table(work: &Work, synthetic: &Path, run: &Path, truth: &Path, rea
             real_up += usize::from(!ground.fell);
             real_assisted_up += usize::from(!assisted.fell);
         }
-        let pull = assisted.assist.as_ref().map_or(f64::NAN, |a| a.mean_force_share_of_weight);
+        let (push, torque) =
+            assisted.assist.as_ref().map_or((f64::NAN, f64::NAN), |a| (a.mean_force_share_of_weight, a.mean_torque_nm));
         let mut row = vec![
             take.name.clone(),
             take.activity.clone(),
             format!("{:.2}", fixed.rms_error_deg),
             ground_cell(ground),
-            format!("{}; pull {:.0}%", ground_cell(assisted), 100.0 * pull),
+            format!("{}; push {:.1}%, torque {:.0} N·m", ground_cell(assisted), 100.0 * push, torque),
         ];
         let mut figures = json!({
             "take": take.name,
@@ -110,7 +111,8 @@ pub(super) fn table(work: &Work, synthetic: &Path, run: &Path, truth: &Path, rea
             "ground": figures(ground),
             "assisted": figures(assisted),
         });
-        figures["assisted"]["mean_force_share_of_weight"] = json!(pull);
+        figures["assisted"]["mean_force_share_of_weight"] = json!(push);
+        figures["assisted"]["mean_torque_nm"] = json!(torque);
         // Trial one's run, re-made by its primitives, standing.
         if take.source == Source::Tracked {
             let imitation = imitate_run(run, &motion, Some(truth), &settings[1], || {})
@@ -154,7 +156,7 @@ pub(super) fn table(work: &Work, synthetic: &Path, run: &Path, truth: &Path, rea
             "Each take played by `imitate execute` with its defaults ({rate} Hz, a first frame that is a bind pose \
              left out, but not from the tracked run, imitated frame for frame): on a stand (fixed base), standing \
              on the ground with balance and stepping, and on the ground with \
-             `--assist` (the mean pull as a share of body weight); RMS joint error against the take's targets, \
+             `--assist` (its mean push as a share of body weight and its mean torque); RMS joint error against the take's targets, \
              when it fell, and on the ground how closely the feet followed the take's own contacts (the share of \
              the feet that touched the ground exactly when the take stood on them, before any fall). Trial one's \
              run (6 particles, its first seed) is also imitated by its primitives (`--primitives --truth`, \
