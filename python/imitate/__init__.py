@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any, Dict, Optional, Tuple, Union
 
 from . import _imitate
 from ._imitate import (
+    EXECUTE_LOOKAHEAD_S,
     EXECUTE_RATE_HZ,
     JOINT_NAMES,
     KEYPOINT_SITES,
@@ -47,6 +48,7 @@ if TYPE_CHECKING:
     PathLike = Union[str, "os.PathLike[str]"]
 
 __all__ = [
+    "EXECUTE_LOOKAHEAD_S",
     "EXECUTE_RATE_HZ",
     "JOINT_NAMES",
     "KEYPOINT_SITES",
@@ -165,6 +167,7 @@ def execute(
     truth: Optional[PathLike] = None,
     up: Optional[str] = None,
     mapping: Optional[PathLike] = None,
+    lookahead: float = EXECUTE_LOOKAHEAD_S,
 ) -> Any:
     """Plays a motion (a :class:`Motion`, or a BVH path read with ``up`` and
     ``mapping``) on the simulated humanoid as ``imitate execute`` does and
@@ -180,7 +183,10 @@ def execute(
     ``assist`` holds the humanoid up with a residual force (keeping the
     capture point over the feet) and torque (turning the pelvis toward the
     trajectory's) on the pelvis, reported in the table
-    (``assist_force_n``, ``assist_torque_nm``). With ``primitives`` (a ``track`` run folder, in
+    (``assist_force_n``, ``assist_torque_nm``); ``lookahead`` is how far
+    ahead, in seconds, each swing's foot placements are played to choose
+    where the foot lands (0: where the capture point says, unplanned,
+    faster; never with ``assist``). With ``primitives`` (a ``track`` run folder, in
     place of ``motion``) the run's trajectory is imitated by its
     vocabulary's primitives, as ``imitate execute --primitives`` does,
     scored against ``truth`` (a truth.csv) when given. With
@@ -195,7 +201,7 @@ def execute(
     elif not isinstance(motion, Motion):
         motion = read_bvh(motion, up, mapping)
     text = _imitate.execute_table(
-        motion, out, force, fixed_base, balance, tuple(gains), rate, skip, assist, primitives, truth
+        motion, out, force, fixed_base, balance, tuple(gains), rate, skip, assist, primitives, truth, lookahead
     )
     return _table(text, frame)
 

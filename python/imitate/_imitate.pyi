@@ -14,6 +14,7 @@ JOINT_NAMES: List[str]
 KEYPOINT_SITES: List[str]
 """The 15 keypoint sites, in the order of a keypoints array's rows."""
 EXECUTE_RATE_HZ: float
+EXECUTE_LOOKAHEAD_S: float
 """The physics rate ``execute`` runs at by default, steps a second."""
 __version__: str
 
@@ -208,4 +209,5 @@ def execute_table(
     assist: bool = False,
     primitives: Optional[_Path] = None,
     truth: Optional[_Path] = None,
+    lookahead: float = ...,
 ) -> str: ...

@@ -30,6 +30,7 @@ fn _imitate(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let sites: Vec<&str> = imitate::vision::keypoints::Site::ALL.iter().map(|s| s.name()).collect();
     m.add("KEYPOINT_SITES", sites)?;
     m.add("EXECUTE_RATE_HZ", imitate::sim::execute::ExecuteParams::DEFAULT_RATE_HZ)?;
+    m.add("EXECUTE_LOOKAHEAD_S", imitate::sim::execute::ExecuteParams::DEFAULT_LOOKAHEAD_S)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -673,7 +673,7 @@ pub fn score_run(py: Python<'_>, run: PathBuf, truth: PathBuf, settle: f64) -> P
 /// and returns ``execution.csv``'s text, writing the execution's folder
 /// to `out` when given.
 #[pyfunction]
-#[pyo3(signature = (motion, out=None, force=false, fixed_base=false, balance=true, gains=(10000.0, 200.0), rate=ExecuteParams::DEFAULT_RATE_HZ, skip=None, assist=false, primitives=None, truth=None))]
+#[pyo3(signature = (motion, out=None, force=false, fixed_base=false, balance=true, gains=(10000.0, 200.0), rate=ExecuteParams::DEFAULT_RATE_HZ, skip=None, assist=false, primitives=None, truth=None, lookahead=ExecuteParams::DEFAULT_LOOKAHEAD_S))]
 #[allow(clippy::too_many_arguments)]
 pub fn execute_table(
     py: Python<'_>,
@@ -688,11 +688,17 @@ pub fn execute_table(
     assist: bool,
     primitives: Option<PathBuf>,
     truth: Option<PathBuf>,
+    lookahead: f64,
 ) -> PyResult<String> {
     let base = if fixed_base { Base::Fixed } else { Base::Free };
     let gains = Gains { kp_per_s2: gains.0, kd_per_s: gains.1 };
-    let params = ExecuteParams { base, balance, assist, gains, rate_hz: rate }.check().map_err(|e| {
-        let keyword = if e.field() == "rate_hz" { "rate" } else { e.field() };
+    let params = ExecuteParams { base, balance, assist, gains, rate_hz: rate, lookahead_s: lookahead };
+    let params = params.check().map_err(|e| {
+        let keyword = match e.field() {
+            "rate_hz" => "rate",
+            "lookahead_s" => "lookahead",
+            field => field,
+        };
         raise(Class::Options, e.naming(keyword), None)
     })?;
     if primitives.is_some() && skip.is_some() {

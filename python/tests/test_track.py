@@ -137,6 +137,17 @@ def test_execute_returns_the_cli_execution_table_and_writes_its_folder(tmp_path,
         imitate.execute("mocap/punch.bvh", out=tmp_path / "mine", fixed_base=True)
 
 
+def test_execute_plans_swings_as_the_cli_does_and_refuses_an_impossible_lookahead(tmp_path, cli):
+    cli("execute", "mocap/punch.bvh", "-o", tmp_path / "run", "--lookahead", "0.5")
+    imitate.execute("mocap/punch.bvh", out=tmp_path / "mine", lookahead=0.5)
+    summary = json.loads((tmp_path / "mine" / "summary.json").read_text())
+    assert summary == json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["lookahead_s"] == 0.5
+    for bad in [-1.0, 6.0, float("nan")]:
+        with pytest.raises(imitate.OptionsError, match="^lookahead: how far ahead each swing is planned"):
+            imitate.execute("mocap/punch.bvh", lookahead=bad)
+
+
 def test_execute_by_the_primitives_matches_the_cli(tmp_path, cli, run_dir):
     cli("execute", "--primitives", run_dir, "-o", tmp_path / "run", "--fixed-base")
     table = imitate.execute(primitives=run_dir, out=tmp_path / "mine", fixed_base=True)

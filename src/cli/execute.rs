@@ -69,6 +69,13 @@ pub struct Args {
     /// frame of the trajectory.
     #[arg(long, value_name = "HZ", default_value_t = ExecuteParams::DEFAULT_RATE_HZ, allow_hyphen_values = true)]
     pub rate: f64,
+    /// On the ground without --assist, play each swing's possible foot
+    /// placements (5 × 5 within 15 cm of where the capture point puts the
+    /// foot) this many seconds ahead on copies of the world and land the
+    /// foot at the one that keeps the humanoid up best; 0 lands it where
+    /// the capture point says, unplanned, and faster.
+    #[arg(long, value_name = "S", default_value_t = ExecuteParams::DEFAULT_LOOKAHEAD_S, allow_hyphen_values = true)]
+    pub lookahead: f64,
     /// Leave out the trajectory's first N frames. By default the first
     /// frame is left out when it is a bind pose (a T-pose many motion
     /// capture files start with, which no body can leave in one frame),
@@ -103,6 +110,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
         assist: args.assist,
         gains: parse_gains(&args.gains)?,
         rate_hz: args.rate,
+        lookahead_s: args.lookahead,
     }
     .check()
     .map_err(|e| {
@@ -110,6 +118,7 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             ExecuteParamsError::Kp(_) | ExecuteParamsError::Kd(_) => format!("--gains {}", args.gains),
             ExecuteParamsError::Rate(_) => format!("--rate {}", args.rate),
             ExecuteParamsError::AssistFixed => "--assist with --fixed-base".to_string(),
+            ExecuteParamsError::Lookahead(_) => format!("--lookahead {}", args.lookahead),
         };
         UsageError(e.naming(&flag))
     })?;
@@ -155,11 +164,21 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             a.max_force_n
         )
     });
+    // The steps are taken one after another; only the plans run on
+    // several cores.
+    let cores = match summary.planned_swings {
+        0 => "on one core".to_string(),
+        n => {
+            format!("planning {n} swings {:.1} s ahead on {} cores", summary.lookahead_s, rayon::current_num_threads())
+        }
+    };
+    let real_time = summary.duration_s / seconds;
+    let real_time = if real_time < 10.0 { format!("{real_time:.2}") } else { format!("{real_time:.0}") };
     note(
         global,
         &format!(
             "{input}: {} frames, {:.2} s at {:.0} Hz ({} base): joint error {:.2}° RMS, {:.2}° at worst{fell}{assisted} → {output}\n\
-             simulated {:.2} s in {seconds:.3} s on one core ({:.0}× real time, {:.1} µs a step)",
+             simulated {:.2} s in {seconds:.3} s {cores} ({real_time}× real time, {:.1} µs a step)",
             summary.frames,
             summary.duration_s,
             summary.rate_hz,
@@ -167,7 +186,6 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
             summary.rms_error_deg,
             summary.max_error_deg,
             summary.duration_s,
-            summary.duration_s / seconds,
             seconds * 1e6 / summary.steps.max(1) as f64,
         ),
     );

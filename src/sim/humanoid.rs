@@ -331,6 +331,42 @@ impl Humanoid {
         }
     }
 
+    /// A copy of the humanoid in its world as it is now, to try a control
+    /// on ahead of time.
+    pub(super) fn fork(&self) -> Humanoid {
+        let w = &self.world;
+        let world = PhysicsWorld {
+            gravity: w.gravity,
+            integration_parameters: w.integration_parameters,
+            physics_pipeline: PhysicsPipeline::new(),
+            collision_pipeline: CollisionPipeline::new(),
+            islands: w.islands.clone(),
+            broad_phase: w.broad_phase.clone(),
+            narrow_phase: w.narrow_phase.clone(),
+            bodies: w.bodies.clone(),
+            colliders: w.colliders.clone(),
+            impulse_joints: w.impulse_joints.clone(),
+            multibody_joints: w.multibody_joints.clone(),
+            soft_bodies: w.soft_bodies.clone(),
+            ccd_solver: w.ccd_solver.clone(),
+        };
+        Humanoid {
+            world,
+            links: self.links,
+            colliders: self.colliders,
+            ground: self.ground,
+            raised_m: self.raised_m,
+            actuators: self.actuators.clone(),
+            torque_limits: self.torque_limits,
+            inertials: self.inertials,
+            carried: self.carried.clone(),
+            offsets: self.offsets,
+            soles: self.soles,
+            anchor: self.anchor,
+            assist_force: self.assist_force,
+        }
+    }
+
     /// The whole body's mass, kg.
     pub(super) fn mass_kg(&self) -> f64 {
         self.inertials.iter().map(|i| i.mass_kg).sum()
@@ -707,6 +743,31 @@ mod tests {
         // More than halfway: the planted legs give way partly (3.3° left).
         assert!(off < 0.075, "the pelvis tilts {:.1}° from the take's", off.to_degrees());
         assert!(FEET.iter().all(|&f| humanoid.stands(f)), "both feet on the ground");
+    }
+
+    #[test]
+    fn a_fork_plays_on_exactly_as_the_humanoid_does_and_leaves_it_alone() {
+        let (_, mut humanoid) = rest_humanoid(Base::Free);
+        let mut targets = [JointTarget::REST; JOINTS];
+        targets[Joint::LeftShoulder.index()].rotation = DQuat::from_rotation_z(0.8);
+        targets[Joint::Spine.index()].rotation = DQuat::from_rotation_x(0.3);
+        // Moving and in contact with the ground when forked.
+        for _ in 0..24 {
+            humanoid.step(&targets, Gains::STANDARD, false);
+        }
+        let at_fork = humanoid.frame();
+        let mut fork = humanoid.fork();
+        for _ in 0..120 {
+            fork.step(&targets, Gains::STANDARD, false);
+        }
+        assert_eq!(humanoid.frame().positions, at_fork.positions, "the humanoid moved with its fork");
+        for _ in 0..120 {
+            humanoid.step(&targets, Gains::STANDARD, false);
+        }
+        let (played, forked) = (humanoid.frame(), fork.frame());
+        assert_ne!(played.positions, at_fork.positions, "the humanoid stood still");
+        assert_eq!(played.positions, forked.positions);
+        assert_eq!(played.rotations, forked.rotations);
     }
 
     #[test]

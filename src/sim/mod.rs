@@ -6,6 +6,7 @@ pub mod anthropometry;
 pub mod assist;
 pub mod balance;
 pub mod bind_pose;
+mod control;
 pub mod execute;
 pub mod humanoid;
 pub mod stepping;

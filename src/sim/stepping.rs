@@ -190,8 +190,16 @@ impl Humanoid {
     /// held flat in the world. A standing stance foot's hip
     /// turns the pelvis to the take's rotation in the world, whatever the
     /// leg beneath does, and its sole is laid halfway to flat as
-    /// [`Humanoid::balance`] does.
-    pub fn step_over(&self, targets: &mut [JointTarget; JOINTS], stance: usize, take_ankle: DVec3, root: &RootTarget) {
+    /// [`Humanoid::balance`] does. `placement` (m, on the ground) moves the
+    /// landing further, as a plan chose it.
+    pub fn step_over(
+        &self,
+        targets: &mut [JointTarget; JOINTS],
+        stance: usize,
+        take_ankle: DVec3,
+        root: &RootTarget,
+        placement: DVec3,
+    ) {
         let swing = 1 - stance;
         let frame = self.frame();
         let pelvis = frame.rotation(Joint::Pelvis);
@@ -200,7 +208,8 @@ impl Humanoid {
         let flat = |v: DVec3| DVec3::new(v.x, 0.0, v.z);
         let velocity = self.world.bodies[self.links[Joint::Pelvis.index()]].linvel().as_dvec3();
         let off = flat(frame.position(Joint::Pelvis) - frame.position(FEET[stance]) - (root.position - take_ankle))
-            + flat(velocity - root.velocity) / omega;
+            + flat(velocity - root.velocity) / omega
+            + placement;
         let (hip, knee, ankle) = (HIPS[swing], FEET[swing].parent().expect("a foot has a shank"), FEET[swing]);
         let leg = (frame.position(hip) - frame.position(ankle)).length().max(0.1);
         // Turning the leg by θ about its hip moves its foot, `leg` below,

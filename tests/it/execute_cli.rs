@@ -360,6 +360,32 @@ fn every_real_capture_plays_on_a_fixed_base_within_five_degrees_and_bind_poses_a
 }
 
 #[test]
+fn planning_each_swing_ahead_carries_a_real_walk_through_that_falls_unplanned() {
+    let Some(walk) = real_bvh_files().into_iter().find(|p| p.file_stem().is_some_and(|s| s == "walking")) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let unplanned = executed(&walk, &dir.path().join("unplanned"), &["--lookahead", "0"]);
+    assert_eq!(unplanned["planned_swings"].as_u64(), Some(0));
+    assert_eq!(number(&unplanned, "lookahead_s"), 0.0);
+    assert!(unplanned["fell"].as_bool().unwrap(), "unplanned, the walk stayed up");
+    let planned = executed(&walk, &dir.path().join("planned"), &[]);
+    assert_eq!(number(&planned, "lookahead_s"), ExecuteParams::DEFAULT_LOOKAHEAD_S);
+    let swings = planned["planned_swings"].as_u64().unwrap();
+    assert!(!planned["fell"].as_bool().unwrap(), "planned, the walk fell at {} s", planned["fell_at_s"]);
+    // Every step of a walk of several seconds is planned, none while the
+    // take stands.
+    assert!(swings >= 6, "{swings} swings planned");
+    // Copies of the world played in parallel still give the same bytes.
+    let again = dir.path().join("again");
+    executed(&walk, &again, &[]);
+    for file in ["execution.csv", "summary.json", "executed.bvh"] {
+        let [a, b] = [dir.path().join("planned"), again.clone()].map(|d| fs::read(d.join(file)).unwrap());
+        assert!(a == b, "{file} differs between two planned runs");
+    }
+}
+
+#[test]
 fn bad_input_is_one_clear_error_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let takes = synth(&dir.path().join("takes"), "punch", "1");
@@ -379,7 +405,7 @@ fn bad_input_is_one_clear_error_and_writes_nothing() {
     fs::write(used.join("keep.txt"), "mine").unwrap();
 
     let out = dir.path().join("out");
-    let cases: [(&Path, &Path, &[&str], i32, &str); 12] = [
+    let cases: [(&Path, &Path, &[&str], i32, &str); 15] = [
         (&good, &out, &["--gains", "0,200"], 2, "--gains 0,200: the stiffness gain must be a positive number"),
         (&good, &out, &["--gains", "-5,200"], 2, "--gains -5,200: the stiffness gain must be a positive number"),
         (&good, &out, &["--gains", "100,0"], 2, "--gains 100,0: the damping gain must be a positive number"),
@@ -387,6 +413,9 @@ fn bad_input_is_one_clear_error_and_writes_nothing() {
         (&good, &out, &["--rate", "0"], 2, "--rate 0: the physics rate must be"),
         (&good, &out, &["--rate", "-240"], 2, "--rate -240: the physics rate must be"),
         (&good, &out, &["--skip", "100000"], 2, "--skip 100000: "),
+        (&good, &out, &["--lookahead", "-1"], 2, "--lookahead -1: how far ahead each swing is planned must be"),
+        (&good, &out, &["--lookahead", "6"], 2, "--lookahead 6: how far ahead each swing is planned must be"),
+        (&good, &out, &["--lookahead", "NaN"], 2, "--lookahead NaN: how far ahead each swing is planned must be"),
         (&good, &out, &["--assist", "--fixed-base"], 2, "--assist with --fixed-base: assistance holds a humanoid up"),
         (&empty, &out, &[], 1, "empty.bvh: the file has no frames"),
         (&nan, &out, &[], 1, "nan.bvh:"),
