@@ -166,11 +166,10 @@ pub fn run(args: Args, global: Global) -> anyhow::Result<Outcome> {
     });
     // The steps are taken one after another; only the plans run on
     // several cores.
-    let cores = match summary.planned_swings {
-        0 => "on one core".to_string(),
-        n => {
-            format!("planning {n} swings {:.1} s ahead on {} cores", summary.lookahead_s, rayon::current_num_threads())
-        }
+    let cores = match (summary.planned_swings, rayon::current_num_threads()) {
+        (0, _) => "on one core".to_string(),
+        (n, 1) => format!("planning {n} swings {:.1} s ahead on one core", summary.lookahead_s),
+        (n, cores) => format!("planning {n} swings {:.1} s ahead on {cores} cores", summary.lookahead_s),
     };
     let real_time = summary.duration_s / seconds;
     let real_time = if real_time < 10.0 { format!("{real_time:.2}") } else { format!("{real_time:.0}") };
