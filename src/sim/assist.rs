@@ -22,7 +22,7 @@
 //!   ground are the body toppling, which a force near the centre of mass
 //!   cannot stop: with the push alone, 41 of bandai's 44 walks fell.
 
-use super::balance::{brought_inside, convex_hull};
+use super::balance::{BalanceState, brought_inside, convex_hull};
 use super::humanoid::{GRAVITY_M_S2, Humanoid, to_f64};
 use super::targets::RootTarget;
 use crate::mocap::body::Joint;
@@ -102,10 +102,10 @@ impl Humanoid {
     /// capture point over the feet (`PUSH_GAIN`), and the turning spring
     /// toward `target`'s pelvis, stiffened as the pelvis tilts away from it
     /// (`STIFFEN_FROM_RAD`, `STIFFEN_MAX`) and acting only as far as the
-    /// humanoid needs it (`NEED_MARGIN_M`, `NEED_TILT_RAD`).
-    pub fn assist_toward(&mut self, target: &RootTarget) {
+    /// humanoid needs it (`NEED_MARGIN_M`, `NEED_TILT_RAD`); `state` is
+    /// [`Humanoid::balance_state`] now.
+    pub fn assist_toward(&mut self, target: &RootTarget, state: &BalanceState) {
         let (anchor, handle) = self.anchor.expect("attach_assist comes first");
-        let state = self.balance_state();
         let mass = self.mass_kg();
         // Both feet, standing or not: a swinging foot lands where it is
         // headed. Over the standing feet alone, the push held the capture
@@ -212,7 +212,7 @@ mod tests {
         let (mut humanoid, root) = at_rest(tilt_deg, true);
         // A step to find the feet on the ground.
         humanoid.step(&[JointTarget::REST; JOINTS], Gains::STANDARD, false);
-        humanoid.assist_toward(&root);
+        humanoid.assist_toward(&root, &humanoid.balance_state());
         let (_, handle) = humanoid.anchor.unwrap();
         let joint = &humanoid.world.impulse_joints.get(handle).unwrap().data;
         f64::from(joint.motor(JointAxis::AngX).unwrap().stiffness)
@@ -300,7 +300,7 @@ mod tests {
         let steps = (3.0 / DT) as usize;
         for _ in 0..steps {
             if assisted {
-                humanoid.assist_toward(&root);
+                humanoid.assist_toward(&root, &humanoid.balance_state());
             }
             humanoid.step(&[JointTarget::REST; JOINTS], Gains::STANDARD, false);
             lowest = lowest.min(humanoid.frame().position(Joint::Pelvis).y);

@@ -127,9 +127,10 @@ impl Humanoid {
     /// strategy alone) cannot shift it sideways while both feet stand, as
     /// turning about one ankle's forward axis lifts the other foot (measured: 1
     /// of 23 real captures stayed up that way, falling sideways with the ankles
-    /// at their tilt limit). Nothing changes while no foot stands.
-    pub fn balance(&self, targets: &mut [JointTarget; JOINTS], onto: Option<usize>) {
-        let state = self.balance_state();
+    /// at their tilt limit). Nothing changes while no foot stands. `state`
+    /// is [`Humanoid::balance_state`] now, which the caller shares with the
+    /// assistance.
+    pub fn balance(&self, targets: &mut [JointTarget; JOINTS], onto: Option<usize>, state: &BalanceState) {
         let Some(support) = onto.and_then(|k| state.sole_middles[k]).or(state.stance_centre) else {
             return;
         };

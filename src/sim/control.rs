@@ -81,17 +81,22 @@ impl Controller<'_> {
         let stepping = self.balance && self.contacts.stepping(time_s);
         let root = self.played.root_at(time_s);
         let mut departure_rad = 0.0;
+        // Where the weight is, for the balance and the assistance alike:
+        // neither changes it before the step.
+        let mut state = None;
         if self.balance {
             let mut wanted = *asked;
             self.take.sample(time_s, &mut wanted);
             self.contacts.lift_swing_feet(self.body, root.rotation, time_s, asked);
             let stance = self.contacts.single_stance(time_s);
             match stance {
-                Some((foot, ankle)) if self.swinging(humanoid, time_s).is_some() => {
+                // The swing under way (see `swinging`).
+                Some((foot, ankle)) if !humanoid.stands(FEET[1 - foot]) => {
                     humanoid.step_over(asked, foot, ankle, &root, placement)
                 }
                 _ => {
-                    humanoid.balance(asked, stance.map(|(foot, _)| foot));
+                    let state = state.get_or_insert_with(|| humanoid.balance_state());
+                    humanoid.balance(asked, stance.map(|(foot, _)| foot), state);
                     if stance.is_some() {
                         humanoid.hold_trunk(asked, root.rotation);
                     }
@@ -102,7 +107,8 @@ impl Controller<'_> {
                 .fold(0.0, f64::max);
         }
         if self.assist {
-            humanoid.assist_toward(&root);
+            let state = state.unwrap_or_else(|| humanoid.balance_state());
+            humanoid.assist_toward(&root, &state);
         }
         humanoid.step(asked, self.gains, stepping);
         departure_rad

@@ -682,7 +682,7 @@ mod tests {
         let feet = FEET.map(|f| humanoid.frame().position(f));
         for _ in 0..(5.0 / DT) as usize {
             let mut targets = [JointTarget::REST; JOINTS];
-            humanoid.balance(&mut targets, None);
+            humanoid.balance(&mut targets, None, &humanoid.balance_state());
             humanoid.step(&targets, Gains::STANDARD, false);
         }
         let frame = humanoid.frame();
@@ -713,7 +713,7 @@ mod tests {
         }
         for _ in 0..(5.0 / DT) as usize {
             let mut asked = targets;
-            humanoid.balance(&mut asked, None);
+            humanoid.balance(&mut asked, None, &humanoid.balance_state());
             humanoid.step(&asked, Gains::STANDARD, false);
         }
         let frame = humanoid.frame();
@@ -734,7 +734,7 @@ mod tests {
         let take = DQuat::from_rotation_x(0.15);
         for _ in 0..(1.0 / DT) as usize {
             let mut targets = [JointTarget::REST; JOINTS];
-            humanoid.balance(&mut targets, None);
+            humanoid.balance(&mut targets, None, &humanoid.balance_state());
             humanoid.hold_trunk(&mut targets, take);
             humanoid.step(&targets, Gains::STANDARD, false);
         }
@@ -783,7 +783,7 @@ mod tests {
         let (_, mut humanoid) = rest_humanoid(Base::Free);
         for _ in 0..(3.0 / DT) as usize {
             let mut targets = [JointTarget::REST; JOINTS];
-            humanoid.balance(&mut targets, Some(1));
+            humanoid.balance(&mut targets, Some(1), &humanoid.balance_state());
             humanoid.step(&targets, Gains::STANDARD, false);
         }
         let state = humanoid.balance_state();
