@@ -192,7 +192,8 @@ mod tests {
     /// forward.
     fn at_rest(tilt_deg: f64, assisted: bool) -> (Humanoid, RootTarget) {
         let body = Body::standard();
-        let mut humanoid = Humanoid::new(&body, Base::Free, &Pose::rest(&body), &[JointTarget::REST; JOINTS], DT);
+        let mut humanoid =
+            Humanoid::new(&body, Base::Free, &Pose::rest(&body), &[JointTarget::REST; JOINTS], DT, [false; 2]);
         if assisted {
             humanoid.attach_assist();
         }

@@ -205,7 +205,7 @@ mod tests {
         let pose = bow(&body, 60.0);
         let asked = lean(&body.forward(&pose));
         assert!(asked > FRAC_PI_3, "the bow leans {:.0}°", asked.to_degrees());
-        let humanoid = Humanoid::new(&body, Base::Free, &pose, &[JointTarget::REST; JOINTS], 1.0 / 240.0);
+        let humanoid = Humanoid::new(&body, Base::Free, &pose, &[JointTarget::REST; JOINTS], 1.0 / 240.0, [false; 2]);
         let standing = body.pelvis_height();
         assert!(!fallen(&humanoid, standing, asked), "bowing as asked");
         assert!(fallen(&humanoid, standing, 0.0), "bowing where the trajectory stands upright");

@@ -386,7 +386,7 @@ pub fn execute(
     let dt = frame_time / steps_per_frame as f64;
     let mut asked = [JointTarget::REST; JOINTS];
     played.sample(0.0, &mut asked);
-    let mut humanoid = Humanoid::new(&motion.body, base, played.pose(0), &asked, dt);
+    let mut humanoid = Humanoid::new(&motion.body, base, played.pose(0), &asked, dt, contacts.standing(0));
     let (mut torque, mut at_limit) = ([DVec3::ZERO; JOINTS], [false; JOINTS]);
     let mut peak = [0.0f64; JOINTS];
     let mut limited_steps = [0usize; JOINTS];

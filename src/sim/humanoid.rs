@@ -206,8 +206,21 @@ pub(super) const HIPS: [Joint; 2] = [Joint::LeftHip, Joint::RightHip];
 impl Humanoid {
     /// The humanoid of `body` in `pose`, every joint turning as `start`
     /// asks, stepped every `dt_s`. On a free base the pose is lowered or
-    /// raised until its lowest point touches the ground.
-    pub fn new(body: &Body, base: Base, pose: &Pose, start: &[JointTarget; JOINTS], dt_s: f64) -> Humanoid {
+    /// raised until the lowest point of the feet that are down
+    /// (`feet_down`: left, right) touches the ground, or its lowest point
+    /// where neither is. A take that starts mid-stride, put on its lowest
+    /// point, stood on the foot it swings (the canonical foot, longer than
+    /// a captured one, reaches below the standing sole) and fell within a
+    /// second (2 of bandai's 44 walks); a swing foot below the ground is
+    /// pushed out by the contacts.
+    pub fn new(
+        body: &Body,
+        base: Base,
+        pose: &Pose,
+        start: &[JointTarget; JOINTS],
+        dt_s: f64,
+        feet_down: [bool; 2],
+    ) -> Humanoid {
         let mut world = PhysicsWorld::new();
         world.integration_parameters.dt = dt_s as f32;
         world.gravity = -Vec3::Y * GRAVITY_M_S2 as f32;
@@ -227,7 +240,10 @@ impl Humanoid {
         let mut frame = body.forward(pose);
         let (mut ground, mut raised_m) = (None, 0.0);
         if base == Base::Free {
-            let lowest = Joint::ALL
+            let standing: Vec<Joint> =
+                FEET.into_iter().zip(feet_down).filter_map(|(f, down)| down.then_some(f)).collect();
+            let on = if standing.is_empty() { &Joint::ALL[..] } else { &standing[..] };
+            let lowest = on
                 .iter()
                 .map(|&j| shapes[j.index()].lowest(frame.position(j), frame.rotation(j)))
                 .fold(f64::INFINITY, f64::min);
@@ -625,7 +641,7 @@ mod tests {
 
     fn rest_humanoid(base: Base) -> (Body, Humanoid) {
         let body = Body::standard();
-        let humanoid = Humanoid::new(&body, base, &Pose::rest(&body), &[JointTarget::REST; JOINTS], DT);
+        let humanoid = Humanoid::new(&body, base, &Pose::rest(&body), &[JointTarget::REST; JOINTS], DT, [false; 2]);
         (body, humanoid)
     }
 
@@ -644,6 +660,34 @@ mod tests {
                 i.mass_kg * GRAVITY_M_S2 * DVec3::new(lever.x, 0.0, lever.z).length()
             })
             .sum()
+    }
+
+    #[test]
+    fn the_start_stands_on_the_feet_that_are_down_or_else_on_its_lowest_point() {
+        // The whole body rolled 5° onto its left side: the left foot lowest.
+        let body = Body::standard();
+        let rest = Pose::rest(&body);
+        let mut local = Joint::ALL.map(|j| rest.local_rotation(j));
+        local[Joint::Pelvis.index()] = DQuat::from_rotation_z(-5f64.to_radians()) * local[Joint::Pelvis.index()];
+        let pose = Pose::from_rotations(rest.root, &local);
+        let lowest = |humanoid: &Humanoid, joints: &[Joint]| {
+            let (shapes, frame) = (shapes(&body), humanoid.frame());
+            joints
+                .iter()
+                .map(|&j| shapes[j.index()].lowest(frame.position(j), frame.rotation(j)))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let start = |feet_down| Humanoid::new(&body, Base::Free, &pose, &[JointTarget::REST; JOINTS], DT, feet_down);
+        let [left, right] = FEET;
+        for feet_down in [[false, false], [true, false], [true, true]] {
+            let humanoid = start(feet_down);
+            assert!(lowest(&humanoid, &Joint::ALL).abs() < 1e-6, "{feet_down:?}");
+            assert!(lowest(&humanoid, &[left]).abs() < 1e-6, "{feet_down:?}");
+        }
+        // Standing on the right foot, the lifted left reaches into the floor.
+        let humanoid = start([false, true]);
+        assert!(lowest(&humanoid, &[right]).abs() < 1e-6);
+        assert!(lowest(&humanoid, &[left]) < -0.005, "{}", lowest(&humanoid, &[left]));
     }
 
     #[test]

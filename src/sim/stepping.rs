@@ -26,6 +26,9 @@ const LIFTED_M: f64 = 0.15;
 /// A sole tilted further than this on a frame the take stands on it is a
 /// retargeting failure, not a stance, and does not count.
 const LEVEL_MAX_RAD: f64 = std::f64::consts::FRAC_PI_3;
+/// A foot turning slower than this stands still (a heel strike rolls the
+/// foot down onto its sole at about 3–4 rad/s on bandai's walks).
+const LEVEL_STILL_RAD_S: f64 = 0.5;
 /// The most the swing leg is turned to place its foot.
 const PLACEMENT_MAX_RAD: f64 = 0.5;
 /// How far the take's swing foot is raised halfway through its swing
@@ -152,23 +155,38 @@ impl Contacts {
 
     /// `motion` with each foot turned, for the whole take, by the constant
     /// rotation (in the foot's own frame) that lays its sole flat on the
-    /// first frame the take stands on it, and by how much each was
+    /// first frame the take stands still on it, and by how much each was
     /// turned (left, right; radians). A captured foot runs from the ankle
     /// to the ball of the foot, steeper than the canonical foot's ankle to
     /// toe tip, so a retargeted person standing flat stands on the
     /// canonical body's toes (15–30° on the real captures), and a walk
-    /// lands on them. A foot the take never stands on is left alone.
+    /// lands on them. Still, because a walk's first stance frame is often
+    /// its heel strike, the foot rolling down onto its sole (on bandai's
+    /// feminine walks, one foot of a take was turned 5° and the other
+    /// 24°); a foot never still where the take stands on it is laid flat
+    /// on the first such frame. A foot the take never stands on is left
+    /// alone.
     pub fn level_feet(&self, motion: &Motion) -> (Motion, [f64; 2]) {
         let mut out = motion.clone();
         let mut turned = [0.0; 2];
+        let last = motion.poses.len().saturating_sub(1);
         for (k, foot) in FEET.into_iter().enumerate() {
-            let first_stance = motion.poses.iter().zip(&self.standing).find_map(|(pose, s)| {
-                let world = motion.body.forward(pose).rotation(foot);
-                let sole = world * DVec3::Y;
-                (s[k] && sole.angle_between(DVec3::Y) <= LEVEL_MAX_RAD)
-                    .then(|| world.inverse() * DQuat::from_rotation_arc(sole, DVec3::Y) * world)
+            let world: Vec<DQuat> = motion.poses.iter().map(|pose| motion.body.forward(pose).rotation(foot)).collect();
+            let still = |i: usize| {
+                let (before, after) = (i.saturating_sub(1), (i + 1).min(last));
+                let spin =
+                    world[after].angle_between(world[before]) / (motion.frame_time_s * (after - before).max(1) as f64);
+                spin < LEVEL_STILL_RAD_S
+            };
+            let stances = || {
+                (0..world.len())
+                    .filter(|&i| self.standing[i][k] && (world[i] * DVec3::Y).angle_between(DVec3::Y) <= LEVEL_MAX_RAD)
+            };
+            let flat = stances().find(|&i| still(i)).or_else(|| stances().next()).map(|i| {
+                let sole = world[i] * DVec3::Y;
+                world[i].inverse() * DQuat::from_rotation_arc(sole, DVec3::Y) * world[i]
             });
-            let Some(correction) = first_stance else { continue };
+            let Some(correction) = flat else { continue };
             for pose in &mut out.poses {
                 let mut local = Joint::ALL.map(|j| pose.local_rotation(j));
                 local[foot.index()] *= correction;
@@ -396,7 +414,7 @@ mod tests {
     }
 
     #[test]
-    fn each_foot_is_laid_flat_as_it_first_stands_even_if_it_starts_in_the_air() {
+    fn each_foot_is_laid_flat_as_it_first_stands_still_even_if_it_starts_in_the_air() {
         let take = motion(&[[true, false], [false, false]]);
         let (levelled, turned) = Contacts::of(&take).level_feet(&take);
         for (k, foot) in FEET.into_iter().enumerate() {
@@ -404,5 +422,31 @@ mod tests {
             let sole = levelled.body.forward(&levelled.poses[15]).rotation(foot) * DVec3::Y;
             assert!(sole.angle_between(DVec3::Y) < 1e-9, "{foot:?}");
         }
+    }
+
+    #[test]
+    fn a_foot_rolling_onto_its_sole_is_laid_flat_where_it_comes_to_rest_not_where_it_strikes() {
+        // Both feet stand throughout; the left rolls from heel strike (flat in
+        // the canonical body, 0°) down to the captured 20° at 4° a frame
+        // (2.1 rad/s), then rests there.
+        let body = Body::standard();
+        let mut take = motion(&[[false, false]; 3]);
+        for (k, pose) in take.poses.iter_mut().enumerate().take(5) {
+            let mut local = Joint::ALL.map(|j| pose.local_rotation(j));
+            local[Joint::LeftAnkle.index()] = DQuat::from_rotation_x((4.0 * k as f64).to_radians());
+            *pose = Pose::from_rotations(Pose::rest(&body).root, &local);
+        }
+        let contacts = Contacts::of(&take);
+        assert!((0..5).all(|k| contacts.standing(k)[0]), "the rolling foot stands");
+        let (_, turned) = contacts.level_feet(&take);
+        assert!((turned[0].to_degrees() - 20.0).abs() < 1e-6, "{turned:?}");
+        // A foot never still where it stands is laid flat where it first stands.
+        for (k, pose) in take.poses.iter_mut().enumerate() {
+            let mut local = Joint::ALL.map(|j| pose.local_rotation(j));
+            local[Joint::LeftAnkle.index()] = DQuat::from_rotation_x((20.0 + 2.0 * k as f64).to_radians());
+            *pose = Pose::from_rotations(Pose::rest(&body).root, &local);
+        }
+        let (_, turned) = Contacts::of(&take).level_feet(&take);
+        assert!((turned[0].to_degrees() - 20.0).abs() < 1e-6, "{turned:?}");
     }
 }
