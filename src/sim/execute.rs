@@ -339,9 +339,10 @@ pub struct JointSummary {
     pub clamped_by_deg: f64,
 }
 
-/// A first frame whose lowest point lies further than this from the floor
-/// is said to start in the air or under it (the real captures start within
-/// 8 cm, their skeletons' feet unlike the canonical body's).
+/// A first frame whose standing feet (its lowest point, where it stands on
+/// neither) lie further than this from the floor is said to start in the
+/// air or under it (the real captures start within 7 cm, their skeletons'
+/// feet unlike the canonical body's).
 const OFF_THE_FLOOR_M: f64 = 0.10;
 
 impl Summary {

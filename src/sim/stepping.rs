@@ -83,13 +83,12 @@ impl Contacts {
         // A foot held up the whole take does not stand at its lowest.
         let standing_y = [left.min(right + LIFTED_M), right.min(left + LIFTED_M)];
         let dt = motion.frame_time_s;
-        let last = ankles.len().saturating_sub(1);
         let standing = (0..ankles.len())
             .map(|k| {
-                let (before, after) = (k.saturating_sub(1), (k + 1).min(last));
                 [0, 1].map(|f| {
-                    let travel = ankles[after][f] - ankles[before][f];
-                    let speed = DVec3::new(travel.x, 0.0, travel.z).length() / (dt * (after - before).max(1) as f64);
+                    let speed = per_second(k, ankles.len(), dt, |before, after| {
+                        (ankles[after][f] - ankles[before][f]).with_y(0.0).length()
+                    });
                     ankles[k][f].y < standing_y[f] + CONTACT_RISE_M && speed < CONTACT_SPEED_M_S
                 })
             })
@@ -169,22 +168,29 @@ impl Contacts {
     pub fn level_feet(&self, motion: &Motion) -> (Motion, [f64; 2]) {
         let mut out = motion.clone();
         let mut turned = [0.0; 2];
-        let last = motion.poses.len().saturating_sub(1);
+        let feet: Vec<[DQuat; 2]> = motion
+            .poses
+            .iter()
+            .map(|pose| {
+                let frame = motion.body.forward(pose);
+                FEET.map(|foot| frame.rotation(foot))
+            })
+            .collect();
         for (k, foot) in FEET.into_iter().enumerate() {
-            let world: Vec<DQuat> = motion.poses.iter().map(|pose| motion.body.forward(pose).rotation(foot)).collect();
+            let world = |i: usize| feet[i][k];
             let still = |i: usize| {
-                let (before, after) = (i.saturating_sub(1), (i + 1).min(last));
-                let spin =
-                    world[after].angle_between(world[before]) / (motion.frame_time_s * (after - before).max(1) as f64);
+                let spin = per_second(i, feet.len(), motion.frame_time_s, |before, after| {
+                    world(after).angle_between(world(before))
+                });
                 spin < LEVEL_STILL_RAD_S
             };
             let stances = || {
-                (0..world.len())
-                    .filter(|&i| self.standing[i][k] && (world[i] * DVec3::Y).angle_between(DVec3::Y) <= LEVEL_MAX_RAD)
+                (0..feet.len())
+                    .filter(|&i| self.standing[i][k] && (world(i) * DVec3::Y).angle_between(DVec3::Y) <= LEVEL_MAX_RAD)
             };
             let flat = stances().find(|&i| still(i)).or_else(|| stances().next()).map(|i| {
-                let sole = world[i] * DVec3::Y;
-                world[i].inverse() * DQuat::from_rotation_arc(sole, DVec3::Y) * world[i]
+                let sole = world(i) * DVec3::Y;
+                world(i).inverse() * DQuat::from_rotation_arc(sole, DVec3::Y) * world(i)
             });
             let Some(correction) = flat else { continue };
             for pose in &mut out.poses {
@@ -277,6 +283,14 @@ fn within_reach(marks: &[bool], reach: usize) -> Vec<bool> {
         .collect();
     let last = marks.len().saturating_sub(1);
     (0..marks.len()).map(|k| before[(k + reach).min(last) + 1] > before[k.saturating_sub(reach)]).collect()
+}
+
+/// How fast something changes at frame `k` of `frames` taken every
+/// `dt_s`: `change` between the frames either side of it (the one side at
+/// either end), per second.
+fn per_second(k: usize, frames: usize, dt_s: f64, change: impl Fn(usize, usize) -> f64) -> f64 {
+    let (before, after) = (k.saturating_sub(1), (k + 1).min(frames.saturating_sub(1)));
+    change(before, after) / (dt_s * (after - before).max(1) as f64)
 }
 
 /// Per frame and foot, the swing it is in (see [`Contacts`]'s `swings`):
