@@ -172,7 +172,7 @@ pub struct ExecutedFrame {
     /// ground; `None` on a fixed base and on the first frame.
     pub feet_down: Option<[bool; 2]>,
     /// Whether the take stood on each foot (left, right) on this frame
-    /// ([`Contacts`]: from its ankles' heights and speeds).
+    /// ([`Contacts`]: from its ankles' and toes' heights and speeds).
     pub take_feet_down: [bool; 2],
 }
 
