@@ -121,6 +121,14 @@ pub(super) fn soles(body: &Body) -> [[DVec3; 4]; 2] {
     sole_corners(&shapes(body))
 }
 
+/// The middle of the front edge of `body`'s soles (left, right), each in
+/// its ankle's frame: where its toes touch the ground.
+pub(super) fn toes(body: &Body) -> [DVec3; 2] {
+    // `sole_corners` lists each sole's two heel corners, then its two toe
+    // corners.
+    soles(body).map(|c| 0.5 * (c[2] + c[3]))
+}
+
 /// One joint's motors: one about a hinge's axis, three about a ball
 /// joint's (rapier's AngX, AngY, AngZ).
 #[derive(Clone, Debug)]

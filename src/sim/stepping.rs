@@ -6,7 +6,7 @@
 //! control); until that foot is off, the standing hips hold the trunk. The
 //! take's swing foot is raised to clear the ground.
 
-use super::humanoid::{FEET, GRAVITY_M_S2, HIPS, Humanoid, soles};
+use super::humanoid::{FEET, GRAVITY_M_S2, HIPS, Humanoid, toes};
 use super::targets::{JointTarget, RootTarget, clamp};
 use crate::mocap::body::{Body, JOINTS, Joint};
 use crate::mocap::pose::{Motion, Pose};
@@ -69,16 +69,19 @@ impl Contacts {
     /// foot's ankle or toe joint lay within 3 cm of the floor on all but 7
     /// of those 205 frames.
     pub fn of(motion: &Motion) -> Contacts {
-        let toes = soles(&motion.body).map(|c| 0.5 * (c[2] + c[3]));
-        let mut ankles = Vec::with_capacity(motion.poses.len());
+        let toes = toes(&motion.body);
         // Per frame, foot and point (ankle, toe): where it is.
-        let mut points: Vec<[[DVec3; 2]; 2]> = Vec::with_capacity(motion.poses.len());
-        for pose in &motion.poses {
-            let frame = motion.body.forward(pose);
-            let ankle = FEET.map(|f| frame.position(f));
-            ankles.push(ankle);
-            points.push([0, 1].map(|f| [ankle[f], ankle[f] + frame.rotation(FEET[f]) * toes[f]]));
-        }
+        let points: Vec<[[DVec3; 2]; 2]> = motion
+            .poses
+            .iter()
+            .map(|pose| {
+                let frame = motion.body.forward(pose);
+                [0, 1].map(|f| {
+                    let ankle = frame.position(FEET[f]);
+                    [ankle, ankle + frame.rotation(FEET[f]) * toes[f]]
+                })
+            })
+            .collect();
         // Each foot's own: a retargeted take may hold one ankle a few
         // centimetres higher than the other throughout (measured on bandai:
         // standing gestures read as standing on one foot against the lower
@@ -106,6 +109,7 @@ impl Contacts {
         let reach = (STEPPING_WITHIN_S / dt).round() as usize;
         let stepping = within_reach(&standing.iter().map(|s| s[0] != s[1]).collect::<Vec<_>>(), reach);
         let swings = swings(&standing);
+        let ankles = points.iter().map(|at| at.map(|[ankle, _]| ankle)).collect();
         Contacts { frame_time_s: dt, standing, ankles, stepping, swings }
     }
 
@@ -499,8 +503,7 @@ mod tests {
         }
         let toe = |pose: &Pose| {
             let frame = body.forward(pose);
-            let tip = soles(&body)[0];
-            (frame.position(Joint::LeftAnkle) + frame.rotation(Joint::LeftAnkle) * (0.5 * (tip[2] + tip[3]))).y
+            (frame.position(Joint::LeftAnkle) + frame.rotation(Joint::LeftAnkle) * toes(&body)[0]).y
         };
         let turned = Pose::from_rotations(flat.root, &local);
         let raised_m = toe(&flat) - toe(&turned);
